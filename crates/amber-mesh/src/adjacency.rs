@@ -1,0 +1,132 @@
+//! Facet adjacency: which element lies across each facet.
+
+use crate::{Mesh, MeshError};
+
+/// For every element and local facet (the facet opposite local vertex `i`), the neighbouring
+/// element across it, or none on the boundary.
+#[derive(Clone, Debug)]
+pub struct FacetAdjacency {
+    nodes_per_element: usize,
+    /// `neighbours[e * (D + 1) + i]`: element across the facet opposite vertex `i` of `e`, or
+    /// [`Self::BOUNDARY`].
+    neighbours: Vec<u32>,
+}
+
+impl FacetAdjacency {
+    /// Marker for a facet on the boundary.
+    pub const BOUNDARY: u32 = u32::MAX;
+
+    /// Builds the adjacency by sorting facet keys (O(n log n), deterministic).
+    ///
+    /// Fails if a facet is shared by more than two elements.
+    pub fn new<const D: usize>(mesh: &Mesh<D>) -> Result<Self, MeshError> {
+        let n = D + 1;
+        let mut facets: Vec<([u32; 3], u32)> = Vec::with_capacity(mesh.cells().len());
+        for (e, cell) in mesh.elements().enumerate() {
+            for i in 0..n {
+                let mut key = [u32::MAX; 3];
+                let mut k = 0;
+                for (j, &v) in cell.iter().enumerate() {
+                    if j != i {
+                        key[k] = v;
+                        k += 1;
+                    }
+                }
+                key[..D].sort_unstable();
+                facets.push((key, (e * n + i) as u32));
+            }
+        }
+        facets.sort_unstable();
+        let mut neighbours = vec![Self::BOUNDARY; facets.len()];
+        let mut i = 0;
+        while i < facets.len() {
+            let mut j = i + 1;
+            while j < facets.len() && facets[j].0 == facets[i].0 {
+                j += 1;
+            }
+            match j - i {
+                1 => {}
+                2 => {
+                    let (a, b) = (facets[i].1 as usize, facets[i + 1].1 as usize);
+                    neighbours[a] = (b / n) as u32;
+                    neighbours[b] = (a / n) as u32;
+                }
+                _ => return Err(MeshError::NonManifoldFacet { facet: facets[i].0[..D].to_vec() }),
+            }
+            i = j;
+        }
+        Ok(Self { nodes_per_element: n, neighbours })
+    }
+
+    /// The element across the facet opposite local vertex `local` of `element`, if any.
+    pub fn neighbour(&self, element: usize, local: usize) -> Option<usize> {
+        let n = self.neighbours[element * self.nodes_per_element + local];
+        (n != Self::BOUNDARY).then_some(n as usize)
+    }
+
+    /// Neighbours of `element` per local facet ([`Self::BOUNDARY`] on the boundary).
+    pub fn neighbours_of(&self, element: usize) -> &[u32] {
+        &self.neighbours[element * self.nodes_per_element..(element + 1) * self.nodes_per_element]
+    }
+
+    /// All `(element, local facet)` pairs on the boundary, in element order.
+    pub fn boundary_facets(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.neighbours
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| **n == Self::BOUNDARY)
+            .map(|(k, _)| (k / self.nodes_per_element, k % self.nodes_per_element))
+    }
+
+    /// Flags every vertex that lies on a boundary facet.
+    pub fn boundary_vertices<const D: usize>(&self, mesh: &Mesh<D>) -> Vec<bool> {
+        let mut on_boundary = vec![false; mesh.num_vertices()];
+        for (e, local) in self.boundary_facets() {
+            for (j, &v) in mesh.element(e).iter().enumerate() {
+                if j != local {
+                    on_boundary[v as usize] = true;
+                }
+            }
+        }
+        on_boundary
+    }
+
+    /// Number of interior facets (each counted once).
+    pub fn num_interior_facets(&self) -> usize {
+        self.neighbours.iter().filter(|&&n| n != Self::BOUNDARY).count() / 2
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Mesh2, Mesh3};
+
+    #[test]
+    fn two_triangles_share_one_edge() {
+        let m = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![0, 1, 2, 0, 2, 3]).unwrap();
+        let adj = FacetAdjacency::new(&m).unwrap();
+        // Facet opposite vertex 1 of element 0 is edge (0, 2), shared with element 1.
+        assert_eq!(adj.neighbour(0, 1), Some(1));
+        assert_eq!(adj.neighbour(1, 2), Some(0));
+        assert_eq!(adj.boundary_facets().count(), 4);
+        assert_eq!(adj.num_interior_facets(), 1);
+        assert!(adj.boundary_vertices(&m).iter().all(|&b| b));
+    }
+
+    #[test]
+    fn two_tets_share_one_face() {
+        let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+        let m = Mesh3::new_reoriented(v, vec![0, 1, 2, 3, 0, 1, 2, 4]).unwrap();
+        let adj = FacetAdjacency::new(&m).unwrap();
+        assert_eq!(adj.num_interior_facets(), 1);
+        assert_eq!(adj.boundary_facets().count(), 6);
+    }
+
+    #[test]
+    fn non_manifold_edge_is_an_error() {
+        let v = vec![[0.0, 0.0], [1.0, 0.0], [0.5, 1.0], [0.5, -1.0], [0.5, 2.0]];
+        let m = Mesh2::new_reoriented(v, vec![0, 1, 2, 0, 1, 3, 0, 1, 4]).unwrap();
+        assert!(matches!(FacetAdjacency::new(&m), Err(MeshError::NonManifoldFacet { .. })));
+    }
+}

@@ -1,0 +1,33 @@
+//! Errors of mesh construction, I/O and queries.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong building, reading or writing a mesh.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum MeshError {
+    /// The flat connectivity length is not a multiple of the nodes per element.
+    #[error("connectivity has {len} indices, not a multiple of {nodes_per_element} nodes per element")]
+    Connectivity { len: usize, nodes_per_element: usize },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFiniteVertex { vertex: usize },
+    /// An element references a vertex that does not exist.
+    #[error("element {element} references vertex {vertex}, but the mesh has {num_vertices} vertices")]
+    VertexOutOfRange { element: usize, vertex: u32, num_vertices: usize },
+    /// An element is degenerate or inverted.
+    #[error("element {element} has non-positive volume {volume:e} (degenerate or inverted)")]
+    NonPositiveElement { element: usize, volume: f64 },
+    /// A facet is shared by more than two elements.
+    #[error("facet {facet:?} is shared by more than two elements (non-manifold mesh)")]
+    NonManifoldFacet { facet: Vec<u32> },
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    /// A file was read but its content is malformed.
+    #[error("{path}:{line}: {message}")]
+    Parse { path: PathBuf, line: usize, message: String },
+    /// The file extension names no supported format.
+    #[error("{path}: unsupported mesh format (expected one of {expected})")]
+    UnsupportedFormat { path: PathBuf, expected: &'static str },
+}

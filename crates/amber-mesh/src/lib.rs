@@ -1,0 +1,18 @@
+//! Simplicial meshes in 2D and 3D, the layer every other amber crate stands on.
+//!
+//! A [`Mesh<D>`] holds vertices and positively oriented simplices (triangles for `D = 2`,
+//! tetrahedra for `D = 3`). It answers per-element geometry (volume, midpoint, the element size
+//! h(K) of spec §0), facet adjacency ([`FacetAdjacency`]), point location ([`PointLocator`]), and
+//! reads and writes meshes (`.vtu`, gmsh `.msh` 4.1, JSON) and renders 2D meshes to PNG.
+//!
+//! This crate knows nothing of sizing fields, mesh generation, FEM, graphs or learning.
+
+mod adjacency;
+mod error;
+mod locate;
+mod mesh;
+
+pub use adjacency::FacetAdjacency;
+pub use error::MeshError;
+pub use locate::{Location, PointLocator};
+pub use mesh::{Mesh, Mesh2, Mesh3, centroid, signed_volume, size_from_volume, volume_from_size};

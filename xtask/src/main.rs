@@ -1,0 +1,5 @@
+//! `cargo xtask`: benchmarks, datasets and reproductions of the paper's experiments.
+
+fn main() -> anyhow::Result<()> {
+    Ok(())
+}
