@@ -3,3 +3,18 @@
 //!
 //! Every mesh that leaves this crate is conforming, positively oriented and covers its geometry.
 //! This crate knows nothing of FEM, graphs or learning.
+
+mod domain;
+mod error;
+mod mesh2d;
+mod quality;
+mod sizing;
+
+pub use domain::PolygonDomain;
+pub use error::MeshgenError;
+pub use mesh2d::{Mesh2dParams, generate_2d, uniform_mesh_2d};
+pub use quality::{QualityReport, quantile};
+pub use sizing::{ClampedSize, ConstantSize, FnSize, MeshSizing, PixelGridSizing, SizingField, estimated_element_count};
+
+pub mod rgb;
+pub mod mesh3d;

@@ -1,0 +1,209 @@
+//! 2D geometry: polygons with holes, and the L-shape of the Poisson task.
+
+use serde::{Deserialize, Serialize};
+
+use crate::MeshgenError;
+
+/// A polygonal domain: one outer ring and any number of holes (each a closed ring of at least
+/// three vertices, the closing edge implied).
+///
+/// Invariant (checked by [`PolygonDomain::new`]): finite coordinates, no repeated consecutive
+/// vertices, no two edges intersect except consecutive edges at their shared vertex, every hole
+/// lies inside the outer ring.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PolygonDomain {
+    outer: Vec<[f64; 2]>,
+    holes: Vec<Vec<[f64; 2]>>,
+}
+
+impl PolygonDomain {
+    /// Validates and builds a domain.
+    pub fn new(outer: Vec<[f64; 2]>, holes: Vec<Vec<[f64; 2]>>) -> Result<Self, MeshgenError> {
+        let domain = Self { outer, holes };
+        domain.validate()?;
+        Ok(domain)
+    }
+
+    /// The L-shape of spec §1: the unit square minus the top-right rectangle [px,1]×[py,1].
+    pub fn lshape(corner: [f64; 2]) -> Result<Self, MeshgenError> {
+        let [px, py] = corner;
+        if !(px > 0.0 && px < 1.0 && py > 0.0 && py < 1.0) {
+            return Err(MeshgenError::InvalidDomain(format!("L-shape corner {corner:?} must lie inside (0, 1)²")));
+        }
+        Self::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, py], [px, py], [px, 1.0], [0.0, 1.0]], vec![])
+    }
+
+    /// The outer ring.
+    pub fn outer(&self) -> &[[f64; 2]] {
+        &self.outer
+    }
+
+    /// The holes.
+    pub fn holes(&self) -> &[Vec<[f64; 2]>] {
+        &self.holes
+    }
+
+    /// All rings, outer first.
+    pub fn rings(&self) -> impl Iterator<Item = &[[f64; 2]]> {
+        std::iter::once(self.outer.as_slice()).chain(self.holes.iter().map(Vec::as_slice))
+    }
+
+    /// Enclosed area (outer minus holes).
+    pub fn area(&self) -> f64 {
+        ring_area(&self.outer).abs() - self.holes.iter().map(|h| ring_area(h).abs()).sum::<f64>()
+    }
+
+    /// Whether `p` lies strictly inside the domain (even-odd rule over all rings).
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        self.rings().filter(|ring| ring_contains(ring, p)).count() % 2 == 1
+    }
+
+    /// Axis-aligned bounding box `(min, max)`.
+    pub fn bounding_box(&self) -> ([f64; 2], [f64; 2]) {
+        self.outer.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), p| {
+            ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])])
+        })
+    }
+
+    fn validate(&self) -> Result<(), MeshgenError> {
+        let invalid = |msg: String| Err(MeshgenError::InvalidDomain(msg));
+        for (r, ring) in self.rings().enumerate() {
+            if ring.len() < 3 {
+                return invalid(format!("ring {r} has {} vertices, at least 3 are needed", ring.len()));
+            }
+            if let Some(i) = ring.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
+                return invalid(format!("ring {r}, vertex {i} has a non-finite coordinate"));
+            }
+            for i in 0..ring.len() {
+                if ring[i] == ring[(i + 1) % ring.len()] {
+                    return invalid(format!("ring {r}, vertices {i} and {} coincide", (i + 1) % ring.len()));
+                }
+            }
+            if ring_area(ring) == 0.0 {
+                return invalid(format!("ring {r} encloses no area"));
+            }
+        }
+        self.check_no_intersections()?;
+        for (h, hole) in self.holes.iter().enumerate() {
+            if !ring_contains(&self.outer, hole[0]) {
+                return invalid(format!("hole {h} lies outside the outer ring"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Sweep over edges sorted by their lowest x: only edges whose x-ranges overlap are tested.
+    fn check_no_intersections(&self) -> Result<(), MeshgenError> {
+        struct Edge {
+            ring: usize,
+            index: usize,
+            ring_len: usize,
+            a: [f64; 2],
+            b: [f64; 2],
+        }
+        let mut edges: Vec<Edge> = self
+            .rings()
+            .enumerate()
+            .flat_map(|(ring, pts)| {
+                (0..pts.len()).map(move |index| Edge { ring, index, ring_len: pts.len(), a: pts[index], b: pts[(index + 1) % pts.len()] })
+            })
+            .collect();
+        edges.sort_by(|e, f| e.a[0].min(e.b[0]).total_cmp(&f.a[0].min(f.b[0])));
+        for i in 0..edges.len() {
+            let e = &edges[i];
+            let e_max = e.a[0].max(e.b[0]);
+            for f in &edges[i + 1..] {
+                if f.a[0].min(f.b[0]) > e_max {
+                    break;
+                }
+                let adjacent = e.ring == f.ring
+                    && ((e.index + 1) % e.ring_len == f.index || (f.index + 1) % f.ring_len == e.index);
+                let hit = if adjacent { segments_overlap_beyond_shared_vertex(e, f) } else { segments_intersect(e.a, e.b, f.a, f.b) };
+                if hit {
+                    return Err(MeshgenError::SelfIntersecting { ring_a: e.ring, edge_a: e.index, ring_b: f.ring, edge_b: f.index });
+                }
+            }
+        }
+        return Ok(());
+
+        fn segments_overlap_beyond_shared_vertex(e: &Edge, f: &Edge) -> bool {
+            // Consecutive edges share one vertex; they only conflict if collinear and folding back.
+            let (shared, p, q) = if e.b == f.a { (e.b, e.a, f.b) } else { (e.a, e.b, f.a) };
+            let (u, v) = ([p[0] - shared[0], p[1] - shared[1]], [q[0] - shared[0], q[1] - shared[1]]);
+            u[0] * v[1] - u[1] * v[0] == 0.0 && u[0] * v[0] + u[1] * v[1] > 0.0
+        }
+    }
+}
+
+/// Signed area of a closed ring (positive when counter-clockwise).
+fn ring_area(ring: &[[f64; 2]]) -> f64 {
+    0.5 * (0..ring.len())
+        .map(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum::<f64>()
+}
+
+/// Crossing-number test.
+fn ring_contains(ring: &[[f64; 2]], p: [f64; 2]) -> bool {
+    let mut inside = false;
+    for i in 0..ring.len() {
+        let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+        if (a[1] > p[1]) != (b[1] > p[1]) && p[0] < a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// Closed-segment intersection (touching counts).
+fn segments_intersect(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    let (d1, d2, d3, d4) = (orient(c, d, a), orient(c, d, b), orient(a, b, c), orient(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
+        return true;
+    }
+    let on = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        r[0] >= p[0].min(q[0]) && r[0] <= p[0].max(q[0]) && r[1] >= p[1].min(q[1]) && r[1] <= p[1].max(q[1])
+    };
+    (d1 == 0.0 && on(c, d, a)) || (d2 == 0.0 && on(c, d, b)) || (d3 == 0.0 && on(a, b, c)) || (d4 == 0.0 && on(a, b, d))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lshape_area_and_containment() {
+        let d = PolygonDomain::lshape([0.5, 0.25]).unwrap();
+        assert!((d.area() - (1.0 - 0.5 * 0.75)).abs() < 1e-15);
+        assert!(d.contains([0.25, 0.75]));
+        assert!(!d.contains([0.75, 0.75]));
+        assert!(PolygonDomain::lshape([1.2, 0.5]).is_err());
+    }
+
+    #[test]
+    fn bad_polygons_are_rejected() {
+        let bowtie = vec![[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]];
+        assert!(matches!(PolygonDomain::new(bowtie, vec![]), Err(MeshgenError::SelfIntersecting { .. })));
+        let degenerate = vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]];
+        assert!(matches!(PolygonDomain::new(degenerate, vec![]), Err(MeshgenError::InvalidDomain(_))));
+        let repeated = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        assert!(matches!(PolygonDomain::new(repeated, vec![]), Err(MeshgenError::InvalidDomain(_))));
+        let nan = vec![[0.0, 0.0], [1.0, f64::NAN], [0.0, 1.0]];
+        assert!(matches!(PolygonDomain::new(nan, vec![]), Err(MeshgenError::InvalidDomain(_))));
+        let square = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let outside_hole = vec![[2.0, 2.0], [3.0, 2.0], [3.0, 3.0]];
+        assert!(PolygonDomain::new(square.clone(), vec![outside_hole]).is_err());
+        let crossing_hole = vec![[0.5, 0.5], [1.5, 0.5], [0.5, 0.7]];
+        assert!(matches!(PolygonDomain::new(square.clone(), vec![crossing_hole]), Err(MeshgenError::SelfIntersecting { .. })));
+        let hole = vec![[0.25, 0.25], [0.75, 0.25], [0.75, 0.75], [0.25, 0.75]];
+        let d = PolygonDomain::new(square, vec![hole]).unwrap();
+        assert!((d.area() - 0.75).abs() < 1e-15);
+        assert!(!d.contains([0.5, 0.5]));
+    }
+}

@@ -1,0 +1,425 @@
+//! The 2D sizing-field mesh generator (spec §2) on spade's constrained Delaunay triangulation.
+//!
+//! 1. Every boundary edge is split into pieces of equal ∫ds/h, never longer than the field asks.
+//! 2. Delaunay refinement: a triangle whose circumradius exceeds `size_factor`·h(centroid), or
+//!    whose smallest angle is below `min_angle_deg`, gets its circumcentre inserted. A
+//!    circumcentre that encroaches a boundary segment (lies in its diametral circle) or falls
+//!    outside the domain splits that segment at its midpoint instead (Ruppert).
+//! 3. Quality-guarded Laplacian smoothing of interior vertices (a move is kept only if the
+//!    smallest angle of the vertex's star does not drop).
+//! 4. A final constrained Delaunay re-triangulation of the smoothed vertices.
+
+use std::collections::VecDeque;
+
+use amber_mesh::Mesh2;
+use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
+use spade::{ConstrainedDelaunayTriangulation, Intersection, LineIntersectionIterator, Point2, PositionInTriangulation, Triangulation};
+
+use crate::{ConstantSize, MeshgenError, PolygonDomain, SizingField};
+
+type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+
+/// Knobs of the 2D generator.
+#[derive(Clone, Debug)]
+pub struct Mesh2dParams {
+    /// Refuse to build meshes with more triangles than this.
+    pub max_elements: usize,
+    /// A triangle is refined while its circumradius exceeds `size_factor`·h. Calibrated so that
+    /// element sizes (spec §0) centre on h after smoothing.
+    pub size_factor: f64,
+    /// Triangles with a smaller angle are refined (Ruppert; terminates for ≤ ~30°).
+    pub min_angle_deg: f64,
+    /// Quality-guarded Laplacian smoothing passes.
+    pub smoothing_passes: usize,
+}
+
+impl Default for Mesh2dParams {
+    fn default() -> Self {
+        Self { max_elements: 5_000_000, size_factor: 0.75, min_angle_deg: 25.0, smoothing_passes: 3 }
+    }
+}
+
+impl Mesh2dParams {
+    /// Sets the element cap.
+    pub fn with_max_elements(mut self, max_elements: usize) -> Self {
+        self.max_elements = max_elements;
+        self
+    }
+}
+
+/// Meshes `domain` with triangles whose edge lengths follow `field`.
+pub fn generate_2d<F: SizingField<2> + ?Sized>(
+    domain: &PolygonDomain,
+    field: &F,
+    params: &Mesh2dParams,
+) -> Result<Mesh2, MeshgenError> {
+    let size = |p: [f64; 2]| {
+        let h = field.size_at(p);
+        if h.is_finite() && h > 0.0 { Ok(h) } else { Err(MeshgenError::InvalidSize { at: p.to_vec(), value: h }) }
+    };
+    let (points, segments) = discretise_boundary(domain, &size, params.max_elements)?;
+    let mut cdt = bulk_load(points, segments)?;
+    refine(&mut cdt, &size, params)?;
+    let (mut vertices, triangles, segments) = export(&cdt);
+    smooth(&mut vertices, &triangles, &segments, params.smoothing_passes);
+    let cdt = bulk_load(vertices.clone(), segments)?;
+    let (_, triangles, _) = export(&cdt);
+    Ok(Mesh2::new(vertices, triangles)?)
+}
+
+/// A mesh of `domain` with uniform target size `size` (e.g. the initial mesh M⁰, spec §1).
+pub fn uniform_mesh_2d(domain: &PolygonDomain, size: f64, params: &Mesh2dParams) -> Result<Mesh2, MeshgenError> {
+    generate_2d(domain, &ConstantSize(size), params)
+}
+
+/// Splits every boundary edge into `ceil(∫ds/h)` pieces of equal ∫ds/h (never longer than the
+/// field asks, as gmsh does). Returns the points and the boundary segments between them.
+fn discretise_boundary(
+    domain: &PolygonDomain,
+    size: &impl Fn([f64; 2]) -> Result<f64, MeshgenError>,
+    max_elements: usize,
+) -> Result<(Vec<[f64; 2]>, Vec<[usize; 2]>), MeshgenError> {
+    let mut points = Vec::new();
+    let mut segments = Vec::new();
+    let mut samples: Vec<(f64, f64)> = Vec::new();
+    for ring in domain.rings() {
+        let first = points.len();
+        for i in 0..ring.len() {
+            let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+            let at = |t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+            let length = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            // Cumulative ∫ds/h by the midpoint rule, steps of a quarter of the local size.
+            samples.clear();
+            samples.push((0.0, 0.0));
+            let (mut t, mut integral) = (0.0, 0.0);
+            while t < 1.0 {
+                let dt = (0.25 * size(at(t))? / length).min(1.0 - t);
+                integral += dt * length / size(at(t + 0.5 * dt))?;
+                t += dt;
+                samples.push((t, integral));
+                if integral > max_elements as f64 {
+                    return Err(MeshgenError::TooManyElements { cap: max_elements });
+                }
+            }
+            let pieces = ((integral - 1e-9).ceil() as usize).max(1);
+            points.push(a);
+            let mut k = 0;
+            for j in 1..pieces {
+                let target = integral * j as f64 / pieces as f64;
+                while samples[k + 1].1 < target {
+                    k += 1;
+                }
+                let ((t0, i0), (t1, i1)) = (samples[k], samples[k + 1]);
+                points.push(at(t0 + (t1 - t0) * (target - i0) / (i1 - i0)));
+            }
+        }
+        let n = points.len() - first;
+        segments.extend((0..n).map(|j| [first + j, first + (j + 1) % n]));
+    }
+    Ok((points, segments))
+}
+
+fn bulk_load(points: Vec<[f64; 2]>, segments: Vec<[usize; 2]>) -> Result<Cdt, MeshgenError> {
+    let n = points.len();
+    let points = points.into_iter().map(|p| Point2::new(p[0], p[1])).collect();
+    let cdt = Cdt::bulk_load_cdt(points, segments).map_err(|e| MeshgenError::Triangulation(format!("{e:?}")))?;
+    if cdt.num_vertices() != n {
+        return Err(MeshgenError::Triangulation(format!("{} of {n} points coincide", n - cdt.num_vertices())));
+    }
+    Ok(cdt)
+}
+
+const OUTSIDE: u8 = 0;
+const INSIDE: u8 = 1;
+const UNKNOWN: u8 = 2;
+
+/// Inside/outside flag per face index, by flood fill from the convex hull: crossing a
+/// boundary segment toggles the side. Exact (no geometric predicates).
+fn classify_faces(cdt: &Cdt) -> Vec<u8> {
+    let mut side = vec![UNKNOWN; cdt.num_all_faces()];
+    side[cdt.outer_face().fix().index()] = OUTSIDE;
+    let mut stack = Vec::new();
+    for edge in cdt.convex_hull() {
+        for (e, f) in [(edge, edge.rev().face()), (edge.rev(), edge.face())] {
+            if let Some(inner) = f.as_inner() {
+                let s = if e.is_constraint_edge() { INSIDE } else { OUTSIDE };
+                if side[inner.fix().index()] == UNKNOWN {
+                    side[inner.fix().index()] = s;
+                    stack.push(inner.fix());
+                }
+            }
+        }
+    }
+    while let Some(f) = stack.pop() {
+        let s = side[f.index()];
+        for edge in cdt.face(f).adjacent_edges() {
+            if let Some(next) = edge.rev().face().as_inner() {
+                if side[next.fix().index()] == UNKNOWN {
+                    side[next.fix().index()] = s ^ u8::from(edge.is_constraint_edge());
+                    stack.push(next.fix());
+                }
+            }
+        }
+    }
+    side
+}
+
+/// Extends `side` to the faces around a newly inserted vertex: new faces take the side of
+/// their neighbour around the vertex, toggled across boundary segments.
+fn classify_star(cdt: &Cdt, v: FixedVertexHandle, side: &mut Vec<u8>) {
+    side.resize(cdt.num_all_faces(), UNKNOWN);
+    let star: Vec<_> = cdt.vertex(v).out_edges().collect();
+    for _ in 0..star.len() {
+        let mut progress = false;
+        for e in &star {
+            let f = e.face().fix().index();
+            if side[f] != UNKNOWN {
+                continue;
+            }
+            // The faces left and right of an edge out of v are both in v's star.
+            let before = e.rev().face().fix().index();
+            if side[before] != UNKNOWN {
+                side[f] = side[before] ^ u8::from(e.is_constraint_edge());
+                progress = true;
+            }
+        }
+        if !progress {
+            break;
+        }
+    }
+}
+
+fn refine(
+    cdt: &mut Cdt,
+    size: &impl Fn([f64; 2]) -> Result<f64, MeshgenError>,
+    params: &Mesh2dParams,
+) -> Result<(), MeshgenError> {
+    let mut side = classify_faces(cdt);
+    let mut queue: VecDeque<FixedFaceHandle<InnerTag>> =
+        cdt.fixed_inner_faces().filter(|f| side[f.index()] == INSIDE).collect();
+    let shape_limit = 1.0 / (2.0 * params.min_angle_deg.to_radians().sin());
+    while let Some(fh) = queue.pop_front() {
+        if side[fh.index()] != INSIDE {
+            continue;
+        }
+        let face = cdt.face(fh);
+        let [a, b, c] = face.positions().map(|p| [p.x, p.y]);
+        let (centre, radius2) = circumcircle(a, b, c);
+        let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+        let h = size(centroid)?;
+        let shortest2 = dist2(a, b).min(dist2(b, c)).min(dist2(c, a));
+        let too_large = radius2 > (params.size_factor * h).powi(2);
+        // The floor on the shortest edge stops quality refinement from chasing small input angles.
+        let badly_shaped = radius2 > shape_limit * shape_limit * shortest2 && shortest2 > (0.05 * h).powi(2);
+        if !(too_large || badly_shaped) || !radius2.is_finite() {
+            continue;
+        }
+        if cdt.num_inner_faces() > params.max_elements {
+            return Err(MeshgenError::TooManyElements { cap: params.max_elements });
+        }
+        let hint = face.vertices()[0].fix();
+        let target = Point2::new(centre[0], centre[1]);
+        let encroached = match cdt.locate_with_hint(target, hint) {
+            PositionInTriangulation::OnFace(landing) if side[landing.index()] == INSIDE => cdt
+                .face(landing)
+                .adjacent_edges()
+                .into_iter()
+                .find(|e| e.is_constraint_edge() && encroaches(e.positions(), centre))
+                .map(|e| e.fix()),
+            PositionInTriangulation::OnEdge(e) if !cdt.directed_edge(e).is_constraint_edge() => None,
+            PositionInTriangulation::OnVertex(_) => continue,
+            _ => {
+                // Beyond the boundary: split the first boundary segment between the face and
+                // its circumcentre.
+                let from = Point2::new(centroid[0], centroid[1]);
+                let crossed = LineIntersectionIterator::new(cdt, from, target).find_map(|i| match i {
+                    Intersection::EdgeIntersection(e) | Intersection::EdgeOverlap(e) if e.is_constraint_edge() => Some(e.fix()),
+                    _ => None,
+                });
+                match crossed {
+                    Some(e) => Some(e),
+                    None => continue,
+                }
+            }
+        };
+        let inserted = match encroached {
+            Some(segment) => {
+                let segment = cdt.directed_edge(segment);
+                let [p, q] = segment.positions();
+                let midpoint = Point2::new(0.5 * (p.x + q.x), 0.5 * (p.y + q.y));
+                // Only split where the midpoint lies exactly on the segment, or spade would
+                // leave the segment whole beside a new vertex.
+                match cdt.locate_with_hint(midpoint, segment.from().fix()) {
+                    PositionInTriangulation::OnEdge(e) if e.as_undirected() == segment.fix().as_undirected() => Some(midpoint),
+                    _ => None,
+                }
+            }
+            None => Some(target),
+        };
+        let Some(point) = inserted else { continue };
+        let v = cdt.insert_with_hint(point, hint).map_err(|e| MeshgenError::Triangulation(format!("{e:?}")))?;
+        classify_star(cdt, v, &mut side);
+        for e in cdt.vertex(v).out_edges() {
+            if let Some(f) = e.face().as_inner() {
+                if side[f.fix().index()] == INSIDE {
+                    queue.push_back(f.fix());
+                }
+            }
+        }
+        if encroached.is_some() {
+            // The triangle that asked for the split is still there and may still be bad.
+            queue.push_back(fh);
+        }
+    }
+    Ok(())
+}
+
+/// Whether `p` lies strictly inside the diametral circle of the segment.
+fn encroaches(segment: [Point2<f64>; 2], p: [f64; 2]) -> bool {
+    let [a, b] = segment;
+    let mid = [0.5 * (a.x + b.x), 0.5 * (a.y + b.y)];
+    dist2(mid, p) < 0.25 * dist2([a.x, a.y], [b.x, b.y])
+}
+
+fn dist2(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
+
+/// Circumcentre and squared circumradius.
+fn circumcircle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> ([f64; 2], f64) {
+    let (bx, by, cx, cy) = (b[0] - a[0], b[1] - a[1], c[0] - a[0], c[1] - a[1]);
+    let d = 2.0 * (bx * cy - by * cx);
+    let (b2, c2) = (bx * bx + by * by, cx * cx + cy * cy);
+    let ux = (cy * b2 - by * c2) / d;
+    let uy = (bx * c2 - cx * b2) / d;
+    ([a[0] + ux, a[1] + uy], ux * ux + uy * uy)
+}
+
+/// Vertices (in spade's order), the inside triangles (counter-clockwise), and the boundary
+/// segments.
+fn export(cdt: &Cdt) -> (Vec<[f64; 2]>, Vec<u32>, Vec<[usize; 2]>) {
+    let vertices = cdt.vertices().map(|v| [v.position().x, v.position().y]).collect();
+    let side = classify_faces(cdt);
+    let mut triangles = Vec::with_capacity(3 * cdt.num_inner_faces());
+    for face in cdt.inner_faces() {
+        if side[face.fix().index()] == INSIDE {
+            triangles.extend(face.vertices().map(|v| v.fix().index() as u32));
+        }
+    }
+    let segments = cdt
+        .undirected_edges()
+        .filter(|e| e.is_constraint_edge())
+        .map(|e| e.vertices().map(|v| v.fix().index()))
+        .collect();
+    (vertices, triangles, segments)
+}
+
+/// Quality-guarded Laplacian smoothing: each interior vertex moves to the mean of its
+/// neighbours unless that lowers the smallest angle of its star (Gauss–Seidel order).
+fn smooth(vertices: &mut [[f64; 2]], triangles: &[u32], segments: &[[usize; 2]], passes: usize) {
+    if passes == 0 {
+        return;
+    }
+    let n = vertices.len();
+    let mut fixed = vec![false; n];
+    for s in segments {
+        fixed[s[0]] = true;
+        fixed[s[1]] = true;
+    }
+    let star = Csr::vertex_to_triangles(n, triangles);
+    let neighbours = Csr::vertex_to_neighbours(&star, triangles);
+    for _ in 0..passes {
+        for v in 0..n {
+            let ring = neighbours.row(v);
+            if fixed[v] || ring.is_empty() {
+                continue;
+            }
+            let old = vertices[v];
+            let before = star_quality(vertices, triangles, star.row(v));
+            let inv = 1.0 / ring.len() as f64;
+            vertices[v] = ring.iter().fold([0.0, 0.0], |s, &w| {
+                let p = vertices[w as usize];
+                [s[0] + p[0] * inv, s[1] + p[1] * inv]
+            });
+            if star_quality(vertices, triangles, star.row(v)) < before {
+                vertices[v] = old;
+            }
+        }
+    }
+}
+
+/// A monotone measure of the smallest angle over the triangles of a star: sin²(min angle),
+/// negated for inverted triangles.
+fn star_quality(vertices: &[[f64; 2]], triangles: &[u32], star: &[u32]) -> f64 {
+    star.iter()
+        .map(|&t| {
+            let t = t as usize;
+            let [a, b, c] = [0, 1, 2].map(|k| vertices[triangles[3 * t + k] as usize]);
+            let twice_area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            let (l0, l1, l2) = (dist2(a, b), dist2(b, c), dist2(c, a));
+            // The smallest angle lies opposite the shortest edge, between the two longer ones.
+            let longer_product = (l0 * l1 * l2) / l0.min(l1).min(l2);
+            twice_area * twice_area.abs() / longer_product
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Compressed rows: for each vertex, the triangles containing it.
+struct Csr {
+    offsets: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Csr {
+    fn vertex_to_triangles(num_vertices: usize, triangles: &[u32]) -> Self {
+        let mut offsets = vec![0u32; num_vertices + 1];
+        for &v in triangles {
+            offsets[v as usize + 1] += 1;
+        }
+        for i in 0..num_vertices {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut fill = offsets.clone();
+        let mut items = vec![0u32; triangles.len()];
+        for (k, &v) in triangles.iter().enumerate() {
+            items[fill[v as usize] as usize] = (k / 3) as u32;
+            fill[v as usize] += 1;
+        }
+        Self { offsets, items }
+    }
+
+    /// For each vertex, its distinct edge neighbours, from the vertex-to-triangle rows.
+    fn vertex_to_neighbours(star: &Csr, triangles: &[u32]) -> Self {
+        let n = star.offsets.len() - 1;
+        let mut offsets = Vec::with_capacity(n + 1);
+        offsets.push(0u32);
+        let mut items = Vec::with_capacity(2 * star.items.len());
+        for v in 0..n {
+            let begin = items.len();
+            for &t in star.row(v) {
+                items.extend(triangles[3 * t as usize..3 * t as usize + 3].iter().filter(|&&w| w as usize != v));
+            }
+            items[begin..].sort_unstable();
+            let unique = dedup_in_place(&mut items[begin..]);
+            items.truncate(begin + unique);
+            offsets.push(items.len() as u32);
+        }
+        Self { offsets, items }
+    }
+
+    fn row(&self, i: usize) -> &[u32] {
+        &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+}
+
+/// Moves the distinct values of a sorted slice to its front; returns how many there are.
+fn dedup_in_place(sorted: &mut [u32]) -> usize {
+    let mut unique = 0;
+    for i in 0..sorted.len() {
+        if i == 0 || sorted[i] != sorted[unique - 1] {
+            sorted[unique] = sorted[i];
+            unique += 1;
+        }
+    }
+    unique
+}
