@@ -1,12 +1,12 @@
 //! Meshes the L-shape with a field graded towards the re-entrant corner and prints the quality.
 //!
-//! `cargo run --release -p amber-meshgen --example graded_lshape -- 0.003`
+//! `cargo run --release -p amber-meshgen --example graded_lshape -- 1.0`
 use amber_meshgen::{FnSize, Mesh2dParams, PolygonDomain, QualityReport, generate_2d};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let grading: f64 = std::env::args().nth(1).map(|s| s.parse()).transpose()?.unwrap_or(0.05);
+    let scale: f64 = std::env::args().nth(1).map(|s| s.parse()).transpose()?.unwrap_or(1.0);
     let domain = PolygonDomain::lshape([0.5, 0.5])?;
-    let field = FnSize(move |x: [f64; 2]| (0.002 + grading * ((x[0] - 0.5).powi(2) + (x[1] - 0.5).powi(2)).sqrt()).min(0.1));
+    let field = FnSize(move |x: [f64; 2]| scale * (0.003 + 0.3 * ((x[0] - 0.5).powi(2) + (x[1] - 0.5).powi(2)).sqrt()).min(0.1));
     let start = std::time::Instant::now();
     let mesh = generate_2d(&domain, &field, &Mesh2dParams::default())?;
     let seconds = start.elapsed().as_secs_f64();

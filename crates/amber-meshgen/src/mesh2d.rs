@@ -35,7 +35,7 @@ pub struct Mesh2dParams {
 
 impl Default for Mesh2dParams {
     fn default() -> Self {
-        Self { max_elements: 5_000_000, size_factor: 0.75, min_angle_deg: 25.0, smoothing_passes: 3 }
+        Self { max_elements: 5_000_000, size_factor: 0.78, min_angle_deg: 25.0, smoothing_passes: 3 }
     }
 }
 
@@ -59,11 +59,14 @@ pub fn generate_2d<F: SizingField<2> + ?Sized>(
     };
     let (points, segments) = discretise_boundary(domain, &size, params.max_elements)?;
     let mut cdt = bulk_load(points, segments)?;
-    refine(&mut cdt, &size, params)?;
-    let (mut vertices, triangles, segments) = export(&cdt);
+    let side = refine(&mut cdt, &size, params)?;
+    let (vertices, triangles, segments) = export(&cdt, &side);
+    // Spatially coherent numbering: smoothing, the final triangulation and every consumer of
+    // the mesh (FEM assembly, graphs) touch neighbours that are near in memory.
+    let (mut vertices, triangles, segments) = morton_order(vertices, triangles, segments);
     smooth(&mut vertices, &triangles, &segments, params.smoothing_passes);
     let cdt = bulk_load(vertices.clone(), segments)?;
-    let (_, triangles, _) = export(&cdt);
+    let (_, triangles, _) = export(&cdt, &classify_faces(&cdt));
     Ok(Mesh2::new(vertices, triangles)?)
 }
 
@@ -193,7 +196,7 @@ fn refine(
     cdt: &mut Cdt,
     size: &impl Fn([f64; 2]) -> Result<f64, MeshgenError>,
     params: &Mesh2dParams,
-) -> Result<(), MeshgenError> {
+) -> Result<Vec<u8>, MeshgenError> {
     let mut side = classify_faces(cdt);
     let mut queue: VecDeque<FixedFaceHandle<InnerTag>> =
         cdt.fixed_inner_faces().filter(|f| side[f.index()] == INSIDE).collect();
@@ -271,7 +274,7 @@ fn refine(
             queue.push_back(fh);
         }
     }
-    Ok(())
+    Ok(side)
 }
 
 /// Whether `p` lies strictly inside the diametral circle of the segment.
@@ -297,9 +300,8 @@ fn circumcircle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> ([f64; 2], f64) {
 
 /// Vertices (in spade's order), the inside triangles (counter-clockwise), and the boundary
 /// segments.
-fn export(cdt: &Cdt) -> (Vec<[f64; 2]>, Vec<u32>, Vec<[usize; 2]>) {
+fn export(cdt: &Cdt, side: &[u8]) -> (Vec<[f64; 2]>, Vec<u32>, Vec<[usize; 2]>) {
     let vertices = cdt.vertices().map(|v| [v.position().x, v.position().y]).collect();
-    let side = classify_faces(cdt);
     let mut triangles = Vec::with_capacity(3 * cdt.num_inner_faces());
     for face in cdt.inner_faces() {
         if side[face.fix().index()] == INSIDE {
@@ -312,6 +314,40 @@ fn export(cdt: &Cdt) -> (Vec<[f64; 2]>, Vec<u32>, Vec<[usize; 2]>) {
         .map(|e| e.vertices().map(|v| v.fix().index()))
         .collect();
     (vertices, triangles, segments)
+}
+
+/// Renumbers vertices along a Morton (Z-order) curve.
+fn morton_order(
+    vertices: Vec<[f64; 2]>,
+    triangles: Vec<u32>,
+    segments: Vec<[usize; 2]>,
+) -> (Vec<[f64; 2]>, Vec<u32>, Vec<[usize; 2]>) {
+    let (lo, hi) = vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), p| {
+        ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])])
+    });
+    let scale = ((1u64 << 31) as f64 - 1.0) / (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
+    let spread = |x: f64| {
+        let mut v = x as u64 & 0x7fff_ffff;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        (v | (v << 1)) & 0x5555_5555_5555_5555
+    };
+    let mut order: Vec<(u64, u32)> = vertices
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (spread((p[0] - lo[0]) * scale) | (spread((p[1] - lo[1]) * scale) << 1), i as u32))
+        .collect();
+    order.sort_unstable();
+    let mut new_index = vec![0u32; vertices.len()];
+    for (new, &(_, old)) in order.iter().enumerate() {
+        new_index[old as usize] = new as u32;
+    }
+    let sorted = order.iter().map(|&(_, old)| vertices[old as usize]).collect();
+    let triangles = triangles.into_iter().map(|v| new_index[v as usize]).collect();
+    let segments = segments.into_iter().map(|s| s.map(|v| new_index[v] as usize)).collect();
+    (sorted, triangles, segments)
 }
 
 /// Quality-guarded Laplacian smoothing: each interior vertex moves to the mean of its
