@@ -27,15 +27,21 @@ pub struct Mesh2dParams {
     /// A triangle is refined while its circumradius exceeds `size_factor`·h. Calibrated so that
     /// element sizes (spec §0) centre on h after smoothing.
     pub size_factor: f64,
-    /// Triangles with a smaller angle are refined (Ruppert; terminates for ≤ ~30°).
+    /// Triangles with a smaller angle are refined (Ruppert; terminates for ≤ ~30°), unless
+    /// their shortest edge is already below `quality_floor` times the smallest target size at
+    /// their corners and centroid: features of the geometry smaller than the field asks for
+    /// (a short boundary edge in a coarse mesh) are then kept rather than refined around, as
+    /// gmsh does.
     pub min_angle_deg: f64,
+    /// See `min_angle_deg`.
+    pub quality_floor: f64,
     /// Quality-guarded Laplacian smoothing passes.
     pub smoothing_passes: usize,
 }
 
 impl Default for Mesh2dParams {
     fn default() -> Self {
-        Self { max_elements: 5_000_000, size_factor: 0.78, min_angle_deg: 25.0, smoothing_passes: 3 }
+        Self { max_elements: 5_000_000, size_factor: 0.78, min_angle_deg: 25.0, quality_floor: 0.5, smoothing_passes: 3 }
     }
 }
 
@@ -198,6 +204,7 @@ fn refine(
     params: &Mesh2dParams,
 ) -> Result<Vec<u8>, MeshgenError> {
     let mut side = classify_faces(cdt);
+    let mut vertex_size = cdt.vertices().map(|v| size([v.position().x, v.position().y])).collect::<Result<Vec<_>, _>>()?;
     let mut queue: VecDeque<FixedFaceHandle<InnerTag>> =
         cdt.fixed_inner_faces().filter(|f| side[f.index()] == INSIDE).collect();
     let shape_limit = 1.0 / (2.0 * params.min_angle_deg.to_radians().sin());
@@ -212,8 +219,9 @@ fn refine(
         let h = size(centroid)?;
         let shortest2 = dist2(a, b).min(dist2(b, c)).min(dist2(c, a));
         let too_large = radius2 > (params.size_factor * h).powi(2);
-        // The floor on the shortest edge stops quality refinement from chasing small input angles.
-        let badly_shaped = radius2 > shape_limit * shape_limit * shortest2 && shortest2 > (0.05 * h).powi(2);
+        let smallest_h = face.vertices().iter().map(|v| vertex_size[v.fix().index()]).fold(h, f64::min);
+        let badly_shaped =
+            radius2 > shape_limit * shape_limit * shortest2 && shortest2 > (params.quality_floor * smallest_h).powi(2);
         if !(too_large || badly_shaped) || !radius2.is_finite() {
             continue;
         }
@@ -261,6 +269,7 @@ fn refine(
         };
         let Some(point) = inserted else { continue };
         let v = cdt.insert_with_hint(point, hint).map_err(|e| MeshgenError::Triangulation(format!("{e:?}")))?;
+        vertex_size.push(size([point.x, point.y])?);
         classify_star(cdt, v, &mut side);
         for e in cdt.vertex(v).out_edges() {
             if let Some(f) = e.face().as_inner() {
@@ -458,4 +467,136 @@ fn dedup_in_place(sorted: &mut [u32]) -> usize {
         }
     }
     unique
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{FnSize, QualityReport};
+    use amber_mesh::FacetAdjacency;
+    use proptest::prelude::*;
+
+    /// Checks conformity, orientation, area and that the boundary of the mesh is exactly the
+    /// boundary of the domain.
+    fn assert_valid(mesh: &Mesh2, domain: &PolygonDomain) {
+        let adjacency = FacetAdjacency::new(mesh).expect("every edge shared by at most two triangles");
+        assert!(mesh.volumes().iter().all(|&a| a > 0.0));
+        let area = mesh.total_volume();
+        assert!((area - domain.area()).abs() <= 1e-12 * domain.area(), "area {area} vs {}", domain.area());
+        let on_domain_edge = |p: [f64; 2], q: [f64; 2]| {
+            domain.rings().any(|ring| {
+                (0..ring.len()).any(|i| {
+                    let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+                    let cross = |r: [f64; 2]| ((b[0] - a[0]) * (r[1] - a[1]) - (b[1] - a[1]) * (r[0] - a[0])).abs();
+                    let tol = 1e-12 * dist2(a, b);
+                    let within = |r: [f64; 2]| {
+                        let t = ((r[0] - a[0]) * (b[0] - a[0]) + (r[1] - a[1]) * (b[1] - a[1])) / dist2(a, b);
+                        (-1e-12..=1.0 + 1e-12).contains(&t)
+                    };
+                    cross(p) <= tol && cross(q) <= tol && within(p) && within(q)
+                })
+            })
+        };
+        let mut boundary_length = 0.0;
+        for (e, local) in adjacency.boundary_facets() {
+            let cell = mesh.element(e);
+            let (p, q) = (mesh.vertices()[cell[(local + 1) % 3] as usize], mesh.vertices()[cell[(local + 2) % 3] as usize]);
+            assert!(on_domain_edge(p, q), "boundary edge {p:?}-{q:?} is not on the domain boundary");
+            boundary_length += dist2(p, q).sqrt();
+        }
+        let perimeter: f64 =
+            domain.rings().map(|r| (0..r.len()).map(|i| dist2(r[i], r[(i + 1) % r.len()]).sqrt()).sum::<f64>()).sum();
+        assert!((boundary_length - perimeter).abs() < 1e-9 * perimeter);
+    }
+
+    /// A star-shaped polygon: vertices at sorted angles with random radii.
+    fn star_polygon() -> impl Strategy<Value = Vec<[f64; 2]>> {
+        (5usize..12).prop_flat_map(|n| {
+            (proptest::collection::vec(0.0..1.0f64, n), proptest::collection::vec(0.4..1.0f64, n)).prop_map(move |(jitter, radii)| {
+                (0..n)
+                    .map(|i| {
+                        let angle = (i as f64 + 0.8 * jitter[i]) * std::f64::consts::TAU / n as f64;
+                        [radii[i] * angle.cos(), radii[i] * angle.sin()]
+                    })
+                    .collect()
+            })
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        #[test]
+        fn random_polygons_and_fields_give_valid_meshes(outer in star_polygon(), h0 in 0.04..0.2f64, wave in 0.0..0.8f64) {
+            let domain = PolygonDomain::new(outer, vec![]).unwrap();
+            let field = FnSize(move |x: [f64; 2]| h0 * (1.0 + wave * (5.0 * x[0]).sin() * (3.0 * x[1]).cos()));
+            let mesh = generate_2d(&domain, &field, &Mesh2dParams::default()).unwrap();
+            assert_valid(&mesh, &domain);
+        }
+
+        #[test]
+        fn lshapes_meet_the_quality_bounds(px in 0.2..0.8f64, py in 0.2..0.8f64, h0 in 0.01..0.1f64, grading in 0.0..2.0f64) {
+            let domain = PolygonDomain::lshape([px, py]).unwrap();
+            let field = FnSize(move |x: [f64; 2]| h0 * (0.2 + grading * ((x[0] - px).powi(2) + (x[1] - py).powi(2)).sqrt()).min(1.0));
+            let mesh = generate_2d(&domain, &field, &Mesh2dParams::default()).unwrap();
+            assert_valid(&mesh, &domain);
+            let report = QualityReport::measure(&mesh, &field);
+            prop_assert!(report.min_angle >= 20.0, "min angle {}", report.min_angle);
+            prop_assert!(report.mean_min_angle >= 45.0, "mean min angle {}", report.mean_min_angle);
+        }
+    }
+
+    #[test]
+    fn holes_are_left_empty() {
+        let square = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let hole = vec![[0.3, 0.3], [0.6, 0.35], [0.5, 0.7]];
+        let domain = PolygonDomain::new(square, vec![hole]).unwrap();
+        let mesh = generate_2d(&domain, &ConstantSize(0.05), &Mesh2dParams::default()).unwrap();
+        assert_valid(&mesh, &domain);
+        assert!(mesh.midpoints().iter().all(|&m| domain.contains(m)));
+    }
+
+    #[test]
+    fn uniform_initial_lshape_mesh_is_coarse() {
+        // The Poisson task's M⁰ (h₀ = 0.9467): the reference has 6–12 triangles.
+        for corner in [[0.2, 0.2], [0.5, 0.5], [0.8, 0.3], [0.8, 0.8]] {
+            let domain = PolygonDomain::lshape(corner).unwrap();
+            let mesh = uniform_mesh_2d(&domain, 0.9467, &Mesh2dParams::default()).unwrap();
+            assert!((4..=12).contains(&mesh.num_elements()), "{} triangles for corner {corner:?}", mesh.num_elements());
+            assert_valid(&mesh, &domain);
+        }
+    }
+
+    #[test]
+    fn same_input_gives_the_same_mesh() {
+        let domain = PolygonDomain::lshape([0.4, 0.6]).unwrap();
+        let field = FnSize(|x: [f64; 2]| 0.01 + 0.1 * x[0]);
+        let a = generate_2d(&domain, &field, &Mesh2dParams::default()).unwrap();
+        let b = generate_2d(&domain, &field, &Mesh2dParams::default()).unwrap();
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn invalid_sizes_are_typed_errors() {
+        let domain = PolygonDomain::lshape([0.5, 0.5]).unwrap();
+        for bad in [f64::NAN, 0.0, -0.1, f64::INFINITY] {
+            let result = generate_2d(&domain, &ConstantSize(bad), &Mesh2dParams::default());
+            assert!(matches!(result, Err(MeshgenError::InvalidSize { .. })), "{bad}: {result:?}");
+        }
+        // NaN only in part of the domain is caught too.
+        let patchy = FnSize(|x: [f64; 2]| if x[0] > 0.25 && x[1] < 0.25 { f64::NAN } else { 0.05 });
+        assert!(matches!(generate_2d(&domain, &patchy, &Mesh2dParams::default()), Err(MeshgenError::InvalidSize { .. })));
+    }
+
+    #[test]
+    fn sizes_too_small_for_the_cap_are_refused() {
+        let domain = PolygonDomain::lshape([0.5, 0.5]).unwrap();
+        let params = Mesh2dParams::default().with_max_elements(10_000);
+        // Boundary alone exceeds the cap.
+        let result = generate_2d(&domain, &ConstantSize(1e-9), &params);
+        assert!(matches!(result, Err(MeshgenError::TooManyElements { cap: 10_000 })));
+        // Boundary fits, interior does not.
+        let result = generate_2d(&domain, &ConstantSize(0.003), &params);
+        assert!(matches!(result, Err(MeshgenError::TooManyElements { cap: 10_000 })));
+    }
 }
