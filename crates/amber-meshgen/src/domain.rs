@@ -11,9 +11,26 @@ use crate::MeshgenError;
 /// vertices, no two edges intersect except consecutive edges at their shared vertex, every hole
 /// lies inside the outer ring.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "PolygonRings")]
 pub struct PolygonDomain {
     outer: Vec<[f64; 2]>,
     holes: Vec<Vec<[f64; 2]>>,
+}
+
+/// The unchecked serialised form; deserialising a [`PolygonDomain`] validates it.
+#[derive(Deserialize)]
+struct PolygonRings {
+    outer: Vec<[f64; 2]>,
+    #[serde(default)]
+    holes: Vec<Vec<[f64; 2]>>,
+}
+
+impl TryFrom<PolygonRings> for PolygonDomain {
+    type Error = MeshgenError;
+
+    fn try_from(rings: PolygonRings) -> Result<Self, MeshgenError> {
+        Self::new(rings.outer, rings.holes)
+    }
 }
 
 impl PolygonDomain {
@@ -205,5 +222,13 @@ mod tests {
         let d = PolygonDomain::new(square, vec![hole]).unwrap();
         assert!((d.area() - 0.75).abs() < 1e-15);
         assert!(!d.contains([0.5, 0.5]));
+    }
+
+    #[test]
+    fn deserialising_validates() {
+        let d: PolygonDomain = serde_json::from_str(r#"{"outer": [[0,0],[1,0],[0,1]]}"#).unwrap();
+        assert!((d.area() - 0.5).abs() < 1e-15);
+        let bowtie = r#"{"outer": [[0,0],[1,1],[1,0],[0,1]]}"#;
+        assert!(serde_json::from_str::<PolygonDomain>(bowtie).unwrap_err().to_string().contains("self-intersecting"));
     }
 }
