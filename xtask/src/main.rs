@@ -1,5 +1,37 @@
 //! `cargo xtask`: benchmarks, datasets and reproductions of the paper's experiments.
+//!
+//! Every command writes its results atomically under `results/` (or `--out`), with the settings
+//! and the machine beside the numbers.
+
+mod bench_mesher;
+mod report;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "cargo xtask", about = "amber project automation")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Speed and quality benchmarks; each writes a JSON file under results/bench/.
+    #[command(subcommand)]
+    Bench(Bench),
+}
+
+#[derive(Subcommand)]
+enum Bench {
+    /// The 2D generator on a graded L-shape at ~10k/100k/1M triangles, next to spade's refine().
+    Mesher(bench_mesher::Args),
+}
 
 fn main() -> anyhow::Result<()> {
-    Ok(())
+    // Commands run from any directory; relative paths are taken from the workspace root.
+    std::env::set_current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))?;
+    match Cli::parse().command {
+        Command::Bench(Bench::Mesher(args)) => bench_mesher::run(args),
+    }
 }

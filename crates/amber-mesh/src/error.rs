@@ -27,6 +27,18 @@ pub enum MeshError {
     /// A file was read but its content is malformed.
     #[error("{path}:{line}: {message}")]
     Parse { path: PathBuf, line: usize, message: String },
+    /// A file's content is malformed or cannot be represented, where no line number applies.
+    #[error("{path}: {message}")]
+    Format { path: PathBuf, message: String },
+    /// A file holds a mesh of another dimension than the one asked for.
+    #[error("{path}: holds a {found}D mesh, expected {expected}D")]
+    DimensionMismatch { path: PathBuf, expected: usize, found: usize },
+    /// A file was parsed but its elements do not form a valid mesh.
+    #[error("{path}: {source}")]
+    InvalidMesh { path: PathBuf, source: Box<MeshError> },
+    /// A data field has the wrong number of values for the mesh it belongs to.
+    #[error("{path}: {field} has {len} values, expected {expected}")]
+    DataLength { path: PathBuf, field: String, len: usize, expected: usize },
     /// The file extension names no supported format.
     #[error("{path}: unsupported mesh format (expected one of {expected})")]
     UnsupportedFormat { path: PathBuf, expected: &'static str },

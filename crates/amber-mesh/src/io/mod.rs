@@ -1,0 +1,359 @@
+//! Reading and writing meshes, one entry point per direction, dispatching on the file extension:
+//! `.vtu` (VTK XML, binary), `.msh` (gmsh 4.1 ASCII), `.json`, and `.nas` (NASTRAN bulk data,
+//! read only).
+//!
+//! Every reader keeps only the simplices of the mesh dimension, drops vertices no kept element
+//! uses (a stray vertex would make an FEM system singular) and flips negatively oriented
+//! elements. Every writer writes to a temporary file beside the target and renames it, so a
+//! reader never sees a half-written mesh.
+
+mod json;
+mod msh;
+mod nastran;
+mod vtu;
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use crate::{Mesh, MeshError};
+
+/// Named scalar fields on a mesh: one value per element (`cell`) or per vertex (`point`).
+///
+/// `.vtu`, `.msh` and `.json` store them; `.nas` has none.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshData {
+    /// Per-element fields, by name.
+    pub cell: BTreeMap<String, Vec<f64>>,
+    /// Per-vertex fields, by name.
+    pub point: BTreeMap<String, Vec<f64>>,
+}
+
+impl MeshData {
+    /// No fields.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds (or replaces) a per-element field.
+    pub fn with_cell(mut self, name: impl Into<String>, values: impl Into<Vec<f64>>) -> Self {
+        self.cell.insert(name.into(), values.into());
+        self
+    }
+
+    /// Adds (or replaces) a per-vertex field.
+    pub fn with_point(mut self, name: impl Into<String>, values: impl Into<Vec<f64>>) -> Self {
+        self.point.insert(name.into(), values.into());
+        self
+    }
+
+    /// Whether there are no fields at all.
+    pub fn is_empty(&self) -> bool {
+        self.cell.is_empty() && self.point.is_empty()
+    }
+
+    /// Checks that every field has one value per element or vertex.
+    fn check_lengths(&self, path: &Path, num_elements: usize, num_vertices: usize) -> Result<(), MeshError> {
+        let kinds = [("element", &self.cell, num_elements), ("vertex", &self.point, num_vertices)];
+        for (kind, fields, expected) in kinds {
+            if let Some((name, values)) = fields.iter().find(|(_, v)| v.len() != expected) {
+                return Err(MeshError::DataLength {
+                    path: path.to_owned(),
+                    field: format!("{kind} field `{name}`"),
+                    len: values.len(),
+                    expected,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The formats, named by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Vtu,
+    Msh,
+    Json,
+    Nastran,
+}
+
+const READ_FORMATS: &str = ".vtu, .msh, .json, .nas";
+const WRITE_FORMATS: &str = ".vtu, .msh, .json";
+
+fn format_of(path: &Path) -> Option<Format> {
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    match ext.as_str() {
+        "vtu" => Some(Format::Vtu),
+        "msh" => Some(Format::Msh),
+        "json" => Some(Format::Json),
+        "nas" => Some(Format::Nastran),
+        _ => None,
+    }
+}
+
+/// Reads a mesh, choosing the format by extension (`.vtu`, `.msh`, `.json`, `.nas`).
+///
+/// ```no_run
+/// let mesh: amber_mesh::Mesh3 = amber_mesh::read_mesh("expert.nas")?;
+/// # Ok::<(), amber_mesh::MeshError>(())
+/// ```
+pub fn read_mesh<const D: usize>(path: impl AsRef<Path>) -> Result<Mesh<D>, MeshError> {
+    read_mesh_with_data(path).map(|(mesh, _)| mesh)
+}
+
+/// Reads a mesh and the scalar fields stored with it (none for `.nas`).
+pub fn read_mesh_with_data<const D: usize>(path: impl AsRef<Path>) -> Result<(Mesh<D>, MeshData), MeshError> {
+    let path = path.as_ref();
+    let format = format_of(path)
+        .ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: READ_FORMATS })?;
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
+    match format {
+        Format::Vtu => vtu::read(path, &bytes),
+        Format::Msh => msh::read(path, &bytes),
+        Format::Json => json::read(path, &bytes),
+        Format::Nastran => nastran::read(path, &bytes),
+    }
+}
+
+/// Writes a mesh with optional scalar fields, choosing the format by extension (`.vtu`, `.msh`,
+/// `.json`). The file appears atomically: it is written beside `path` and renamed.
+///
+/// ```no_run
+/// # let mesh = amber_mesh::Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2])?;
+/// let data = amber_mesh::MeshData::new().with_cell("h", mesh.sizes());
+/// amber_mesh::write_mesh(&mesh, "step-03.vtu", &data)?;
+/// # Ok::<(), amber_mesh::MeshError>(())
+/// ```
+pub fn write_mesh<const D: usize>(mesh: &Mesh<D>, path: impl AsRef<Path>, data: &MeshData) -> Result<(), MeshError> {
+    let path = path.as_ref();
+    let unsupported = || MeshError::UnsupportedFormat { path: path.to_owned(), expected: WRITE_FORMATS };
+    let format = format_of(path).ok_or_else(unsupported)?;
+    data.check_lengths(path, mesh.num_elements(), mesh.num_vertices())?;
+    match format {
+        Format::Vtu => write_atomic(path, |w| vtu::write(mesh, data, w, path)),
+        Format::Msh => write_atomic(path, |w| msh::write(mesh, data, w, path)),
+        Format::Json => write_atomic(path, |w| json::write(mesh, data, w, path)),
+        Format::Nastran => Err(unsupported()),
+    }
+}
+
+/// Writes a file through `write` into a temporary file in the same directory, then renames it
+/// over `path`, so the file is either absent, the old one, or complete. Io errors name `path`.
+pub(crate) fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), MeshError>,
+) -> Result<(), MeshError> {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let io_error = |source| MeshError::Io { path: path.to_owned(), source };
+    let name = path.file_name().ok_or_else(|| io_error(std::io::ErrorKind::InvalidInput.into()))?;
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let tmp: PathBuf = dir.join(format!(
+        ".{}.{}-{}.tmp",
+        name.to_string_lossy(),
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let result = File::create(&tmp).map_err(io_error).and_then(|file| {
+        let mut w = BufWriter::new(file);
+        write(&mut w)?;
+        let file = w.into_inner().map_err(|e| io_error(e.into_error()))?;
+        file.sync_all().map_err(io_error)?;
+        std::fs::rename(&tmp, path).map_err(io_error)
+    });
+    if result.is_err() {
+        // Best effort: the temporary file may not even exist.
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Maps an io error while writing `path`.
+fn write_error(path: &Path) -> impl Fn(std::io::Error) -> MeshError + '_ {
+    move |source| MeshError::Io { path: path.to_owned(), source }
+}
+
+/// Builds the mesh a reader parsed: checks the field lengths against what was parsed, drops
+/// unused vertices (remapping per-vertex fields) and reorients negative elements.
+fn assemble<const D: usize>(
+    path: &Path,
+    vertices: Vec<[f64; D]>,
+    cells: Vec<u32>,
+    mut data: MeshData,
+) -> Result<(Mesh<D>, MeshData), MeshError> {
+    let invalid = |source| MeshError::InvalidMesh { path: path.to_owned(), source: Box::new(source) };
+    if !cells.len().is_multiple_of(D + 1) {
+        return Err(invalid(MeshError::Connectivity { len: cells.len(), nodes_per_element: D + 1 }));
+    }
+    data.check_lengths(path, cells.len() / (D + 1), vertices.len())?;
+    let mut new_index = vec![u32::MAX; vertices.len()];
+    for (element, cell) in cells.chunks_exact(D + 1).enumerate() {
+        for &v in cell {
+            let slot = new_index.get_mut(v as usize).ok_or_else(|| {
+                invalid(MeshError::VertexOutOfRange { element, vertex: v, num_vertices: vertices.len() })
+            })?;
+            *slot = 0;
+        }
+    }
+    let kept: Vec<usize> = (0..vertices.len()).filter(|&v| new_index[v] == 0).collect();
+    let (vertices, cells) = if kept.len() == vertices.len() {
+        (vertices, cells)
+    } else {
+        for (new, &old) in kept.iter().enumerate() {
+            new_index[old] = new as u32;
+        }
+        for values in data.point.values_mut() {
+            *values = kept.iter().map(|&old| values[old]).collect();
+        }
+        (kept.iter().map(|&old| vertices[old]).collect(), cells.iter().map(|&v| new_index[v as usize]).collect())
+    };
+    let mesh = Mesh::new_reoriented(vertices, cells).map_err(invalid)?;
+    Ok((mesh, data))
+}
+
+/// Line-by-line reading of a text file with 1-based line numbers for error messages. Lines may
+/// end in LF or CRLF; each line is checked for UTF-8 only when it is read, so a binary file fails
+/// at its first binary line rather than up front.
+struct Lines<'a> {
+    path: &'a Path,
+    rest: &'a [u8],
+    line: usize,
+}
+
+impl<'a> Lines<'a> {
+    fn new(path: &'a Path, bytes: &'a [u8]) -> Self {
+        Self { path, rest: bytes, line: 0 }
+    }
+
+    /// The next line without its line ending, or `None` at the end of the file.
+    fn next(&mut self) -> Result<Option<&'a str>, MeshError> {
+        if self.rest.is_empty() {
+            return Ok(None);
+        }
+        let (line, rest) = match self.rest.iter().position(|&b| b == b'\n') {
+            Some(i) => (&self.rest[..i], &self.rest[i + 1..]),
+            None => (self.rest, &self.rest[self.rest.len()..]),
+        };
+        self.rest = rest;
+        self.line += 1;
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        std::str::from_utf8(line).map(Some).map_err(|_| self.error("not a text line (binary data?)"))
+    }
+
+    /// The next line, which must exist.
+    fn expect(&mut self, what: &str) -> Result<&'a str, MeshError> {
+        self.next()?.ok_or_else(|| MeshError::Parse {
+            path: self.path.to_owned(),
+            line: self.line + 1,
+            message: format!("unexpected end of file, expected {what}"),
+        })
+    }
+
+    /// An error at the current line.
+    fn error(&self, message: impl Into<String>) -> MeshError {
+        MeshError::Parse { path: self.path.to_owned(), line: self.line, message: message.into() }
+    }
+
+    /// Parses one whitespace-separated token of the current line.
+    fn parse<T: std::str::FromStr>(&self, token: Option<&str>, what: &str) -> Result<T, MeshError> {
+        let token = token.ok_or_else(|| self.error(format!("missing {what}")))?;
+        token.parse().map_err(|_| self.error(format!("bad {what} `{token}`")))
+    }
+}
+
+/// A unique scratch directory for one test, removed by the caller.
+#[cfg(test)]
+pub(crate) fn test_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("amber-mesh-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::Write;
+
+    use super::*;
+    use crate::{Mesh2, Mesh3};
+
+    fn square() -> Mesh2 {
+        Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![0, 1, 2, 0, 2, 3]).unwrap()
+    }
+
+    fn tet() -> Mesh3 {
+        Mesh3::new(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3]).unwrap()
+    }
+
+    #[test]
+    fn every_writable_format_round_trips_mesh_and_data() {
+        let dir = test_dir("round-trip");
+        let m2 = square();
+        let d2 = MeshData::new().with_cell("h", m2.sizes()).with_point("u", vec![0.0, 0.5, 1.0, 0.1 + 0.2]);
+        let m3 = tet();
+        let d3 = MeshData::new().with_cell("h", m3.sizes());
+        for ext in ["vtu", "msh", "json", "VTU"] {
+            let p2 = dir.join(format!("m2.{ext}"));
+            write_mesh(&m2, &p2, &d2).unwrap();
+            assert_eq!(read_mesh_with_data::<2>(&p2).unwrap(), (m2.clone(), d2.clone()), "{ext}");
+            let p3 = dir.join(format!("m3.{ext}"));
+            write_mesh(&m3, &p3, &d3).unwrap();
+            assert_eq!(read_mesh_with_data::<3>(&p3).unwrap(), (m3.clone(), d3.clone()), "{ext}");
+        }
+        let leftovers: Vec<_> =
+            std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+        assert!(leftovers.iter().all(|n| !n.to_string_lossy().ends_with(".tmp")), "{leftovers:?}");
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn unknown_extensions_and_nastran_writes_are_unsupported() {
+        let dir = test_dir("unsupported");
+        let err = write_mesh(&square(), dir.join("m.stl"), &MeshData::new()).unwrap_err();
+        assert!(matches!(err, MeshError::UnsupportedFormat { .. }), "{err}");
+        assert!(err.to_string().contains("m.stl"));
+        let err = write_mesh(&tet(), dir.join("m.nas"), &MeshData::new()).unwrap_err();
+        assert!(matches!(err, MeshError::UnsupportedFormat { .. }), "{err}");
+        assert!(matches!(read_mesh::<2>(dir.join("m")), Err(MeshError::UnsupportedFormat { .. })));
+        assert!(matches!(read_mesh::<2>(dir.join("missing.vtu")), Err(MeshError::Io { .. })));
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn fields_of_the_wrong_length_are_rejected_before_writing() {
+        let dir = test_dir("data-length");
+        let path = dir.join("m.vtu");
+        let err = write_mesh(&square(), &path, &MeshData::new().with_cell("h", vec![1.0])).unwrap_err();
+        assert!(matches!(err, MeshError::DataLength { len: 1, expected: 2, .. }), "{err}");
+        assert!(!path.exists());
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_and_no_temporary() {
+        let dir = test_dir("atomic");
+        let path = dir.join("m.json");
+        std::fs::write(&path, "old").unwrap();
+        let err = write_atomic(&path, |w| {
+            w.write_all(b"partial").unwrap();
+            Err(MeshError::Format { path: path.clone(), message: "boom".into() })
+        });
+        assert!(err.is_err());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn assemble_drops_unused_vertices_and_reorients() {
+        let vertices = vec![[9.0, 9.0], [0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let data = MeshData::new().with_point("u", vec![-1.0, 1.0, 2.0, 3.0]).with_cell("h", vec![5.0]);
+        let (mesh, data) = assemble::<2>(Path::new("x"), vertices, vec![1, 3, 2], data).unwrap();
+        assert_eq!(mesh.vertices(), &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        assert!(mesh.volume(0) > 0.0);
+        assert_eq!(data.point["u"], vec![1.0, 2.0, 3.0]);
+        let err = assemble::<2>(Path::new("x"), vec![[0.0, 0.0]], vec![0, 1, 2], MeshData::new()).unwrap_err();
+        assert!(matches!(err, MeshError::InvalidMesh { .. }), "{err}");
+    }
+}

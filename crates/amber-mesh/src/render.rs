@@ -1,0 +1,548 @@
+//! PNG pictures of 2D meshes coloured by a per-element scalar, with a colour bar.
+//!
+//! Triangles are filled straight into an RGB buffer (a pixel takes the colour of the element
+//! containing its centre), edges are drawn as darkened lines, and plotters draws only the text,
+//! with the vendored DejaVu Sans so no system font is needed.
+
+use std::io::Write;
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::prelude::{BitMapBackend, DrawingBackend, IntoFont, RGBColor};
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::{FontStyle, TextStyle};
+
+use crate::io::write_atomic;
+use crate::{Mesh2, MeshError};
+
+/// How to draw a mesh picture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Text above the mesh.
+    pub title: Option<String>,
+    /// Colour by log10 of the values; non-positive values are then drawn as missing.
+    pub log_scale: bool,
+    /// Value range of the colour bar; `None` (or an empty or, on a log scale, non-positive
+    /// range) spans the values. Fix it to compare pictures.
+    pub range: Option<(f64, f64)>,
+    /// Draw element edges. They fade out with element size and vanish for elements thinner
+    /// than about 2 pixels, where lines would hide the colours.
+    pub edges: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self { width: 1000, height: 800, title: None, log_scale: false, range: None, edges: true }
+    }
+}
+
+/// Colour of elements whose value is NaN, infinite, or non-positive on a log scale.
+pub const MISSING_COLOUR: [u8; 3] = [190, 190, 190];
+
+const BACKGROUND: [u8; 3] = [255, 255, 255];
+const INK: [u8; 3] = [0, 0, 0];
+/// Edge pixels are the fill colour scaled by this factor, so edges stay visible on any colour.
+const EDGE_SHADE: f64 = 0.55;
+/// Element thickness (smallest height, in pixels) below which its edges are hidden, and above
+/// which they are drawn at full strength; in between they fade.
+const EDGE_FADE: (f64, f64) = (2.0, 8.0);
+const FONT_FAMILY: &str = "sans-serif";
+const MIN_SIZE: u32 = 64;
+const MAX_SIZE: u32 = 16_384;
+
+/// Registers the vendored DejaVu Sans as plotters' "sans-serif" font (once per process), so
+/// plotters charts anywhere in the program can draw text without system fonts.
+pub fn register_default_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        plotters::style::register_font(FONT_FAMILY, FontStyle::Normal, include_bytes!("../assets/DejaVuSans.ttf"))
+            .unwrap_or_else(|_| unreachable!("the vendored DejaVuSans.ttf is a valid font"));
+    });
+}
+
+/// Viridis at `t` in [0, 1]: Matt Zucker's degree-6 polynomial fit of matplotlib's table
+/// (shadertoy WlfXRN, CC0), within 3/255 of it.
+pub fn viridis(t: f64) -> [u8; 3] {
+    const C: [[f64; 3]; 7] = [
+        [0.277_727_327_223_417_7, 0.005_407_344_544_966_578, 0.334_099_805_335_306_1],
+        [0.105_093_043_108_577_4, 1.404_613_529_898_575, 1.384_590_162_594_685],
+        [-0.330_861_828_725_556_3, 0.214_847_559_468_213, 0.095_095_163_028_236_59],
+        [-4.634_230_498_983_486, -5.799_100_973_351_585, -19.332_440_956_279_87],
+        [6.228_269_936_347_081, 14.179_933_366_805_09, 56.690_552_600_681_05],
+        [4.776_384_997_670_288, -13.745_145_377_746_01, -65.353_032_633_372_34],
+        [-5.435_455_855_934_631, 4.645_852_612_178_535, 26.312_435_249_583_2],
+    ];
+    let t = t.clamp(0.0, 1.0);
+    std::array::from_fn(|k| {
+        let v = C.iter().rev().fold(0.0, |acc, c| acc * t + c[k]);
+        (v.clamp(0.0, 1.0) * 255.0).round() as u8
+    })
+}
+
+/// Writes a PNG of `mesh` with element `e` coloured by `values[e]` on the viridis scale, a colour
+/// bar with tick labels on the right and the optional title on top. The mesh keeps its aspect
+/// ratio. The file appears atomically.
+///
+/// ```no_run
+/// # let mesh = amber_mesh::Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2])?;
+/// let options = amber_mesh::RenderOptions { title: Some("h".into()), log_scale: true, ..Default::default() };
+/// amber_mesh::render_png(&mesh, &mesh.sizes(), &options, "sizes.png")?;
+/// # Ok::<(), amber_mesh::MeshError>(())
+/// ```
+pub fn render_png(
+    mesh: &Mesh2,
+    values: &[f64],
+    options: &RenderOptions,
+    path: impl AsRef<Path>,
+) -> Result<(), MeshError> {
+    let path = path.as_ref();
+    if values.len() != mesh.num_elements() {
+        return Err(MeshError::DataLength {
+            path: path.to_owned(),
+            field: "the rendered values".into(),
+            len: values.len(),
+            expected: mesh.num_elements(),
+        });
+    }
+    let (w, h) = (options.width, options.height);
+    if !(MIN_SIZE..=MAX_SIZE).contains(&w) || !(MIN_SIZE..=MAX_SIZE).contains(&h) {
+        return Err(MeshError::Format {
+            path: path.to_owned(),
+            message: format!("image size {w}×{h} is outside {MIN_SIZE}..={MAX_SIZE} pixels per side"),
+        });
+    }
+    let (image, _) =
+        render(mesh, values, options).map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
+    write_atomic(path, |out| {
+        encode_png(out, w, h, &image).map_err(|source| MeshError::Io { path: path.to_owned(), source })
+    })
+}
+
+fn encode_png(out: &mut impl Write, w: u32, h: u32, rgb: &[u8]) -> std::io::Result<()> {
+    let mut encoder = png::Encoder::new(out, w, h);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Fast);
+    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+    writer.write_image_data(rgb).map_err(std::io::Error::other)?;
+    writer.finish().map_err(std::io::Error::other)
+}
+
+/// Maps values to [0, 1] along the colour bar.
+#[derive(Clone, Copy, Debug)]
+struct Scale {
+    lo: f64,
+    hi: f64,
+    log: bool,
+}
+
+impl Scale {
+    fn new(values: &[f64], options: &RenderOptions) -> Self {
+        let log = options.log_scale;
+        let valid = |v: f64| v.is_finite() && (!log || v > 0.0);
+        let (mut lo, mut hi) = options.range.filter(|&(a, b)| valid(a) && valid(b) && a < b).unwrap_or_else(|| {
+            values
+                .iter()
+                .copied()
+                .filter(|&v| valid(v))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)))
+        });
+        if lo > hi {
+            (lo, hi) = if log { (1.0, 10.0) } else { (0.0, 1.0) };
+        } else if lo == hi {
+            (lo, hi) =
+                if log { (lo / 2.0, hi * 2.0) } else { (lo - lo.abs().max(1.0) * 0.5, hi + hi.abs().max(1.0) * 0.5) };
+        }
+        Self { lo, hi, log }
+    }
+
+    /// Position in [0, 1] (clamped), or `None` for a missing value.
+    fn position(&self, v: f64) -> Option<f64> {
+        if !v.is_finite() || (self.log && v <= 0.0) {
+            return None;
+        }
+        let t = if self.log {
+            (v / self.lo).log10() / (self.hi / self.lo).log10()
+        } else {
+            (v - self.lo) / (self.hi - self.lo)
+        };
+        Some(t.clamp(0.0, 1.0))
+    }
+
+    fn colour(&self, v: f64) -> [u8; 3] {
+        self.position(v).map_or(MISSING_COLOUR, viridis)
+    }
+
+    /// Tick values with their labels: "nice" steps of 1, 2 or 5 × 10^k.
+    fn ticks(&self) -> Vec<(f64, String)> {
+        let (lo, hi) = (self.lo, self.hi);
+        if self.log {
+            let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+            // Every decade up to about eight of them, then every second, third, ...
+            let stride = ((last - first) / 8).max(1);
+            let decades = (first..=last).filter(|k| k.rem_euclid(stride) == 0);
+            for mantissas in [&[1][..], &[1, 2, 5], &[1, 2, 3, 4, 5, 6, 7, 8, 9]] {
+                let ticks: Vec<(f64, String)> = decades
+                    .clone()
+                    .flat_map(|k| {
+                        mantissas.iter().map(move |&m| (m as f64 * 10f64.powi(k), label(m as f64 * 10f64.powi(k), k)))
+                    })
+                    .filter(|&(v, _)| v >= lo * (1.0 - 1e-9) && v <= hi * (1.0 + 1e-9))
+                    .collect();
+                if ticks.len() >= 3 {
+                    return ticks;
+                }
+            }
+        }
+        // Linear ticks, also the fallback for a log range narrower than a few ticks: the step
+        // of 1, 2 or 5 × 10^k that gives closest to five ticks. (Dividing first keeps the
+        // width finite for any finite range.)
+        let k0 = ((hi / 5.0 - lo / 5.0).log10().floor() as i32).clamp(-330, 310);
+        let Some((step, k)) = (k0 - 1..=k0 + 1)
+            .flat_map(|k| [1.0, 2.0, 5.0].map(|m| (m * 10f64.powi(k), k)))
+            .filter(|&(step, _)| step.is_normal() && (hi / step).is_finite() && (lo / step).is_finite())
+            .min_by_key(|&(step, _)| ((hi / step).floor() - (lo / step).ceil() + 1.0 - 5.0).abs() as i64)
+        else {
+            return Vec::new();
+        };
+        let first = (lo / step - 1e-9).ceil() as i64;
+        let last = (hi / step + 1e-9).floor() as i64;
+        (first..=last).map(|i| i as f64 * step).map(|v| (v, label(v, k))).collect()
+    }
+}
+
+/// A tick label showing `value` to the precision of 10^`exponent`: fixed-point for moderate
+/// magnitudes, scientific otherwise.
+fn label(value: f64, exponent: i32) -> String {
+    let magnitude = value.abs();
+    if magnitude < 10f64.powi(exponent) * 1e-6 {
+        "0".into()
+    } else if (1e-3..1e5).contains(&magnitude) {
+        format!("{:.*}", (-exponent).max(0) as usize, value)
+    } else {
+        let e = magnitude.log10().floor() as i32;
+        format!("{:.*e}", (e - exponent).max(0) as usize, value)
+    }
+}
+
+/// Where things go on the canvas, in pixels.
+#[derive(Clone, Copy, Debug)]
+struct Layout {
+    /// World → pixel: `px = x0 + (x - xmin) * scale`, `py = y0 - (y - ymin) * scale` (y up).
+    x0: f64,
+    y0: f64,
+    xmin: f64,
+    ymin: f64,
+    scale: f64,
+    /// Colour bar rectangle `[left, top, right, bottom)`.
+    bar: [i64; 4],
+    font: f64,
+    title_font: f64,
+}
+
+impl Layout {
+    fn new(mesh: &Mesh2, options: &RenderOptions, label_width: f64) -> Self {
+        let (w, h) = (options.width as f64, options.height as f64);
+        let margin = (w.min(h) / 40.0).max(6.0);
+        let font = (h / 40.0).clamp(10.0, 20.0);
+        let title_font = (h / 28.0).clamp(12.0, 28.0);
+        let top = margin + if options.title.is_some() { 1.6 * title_font } else { font / 2.0 };
+        let bottom = h - margin - font / 2.0;
+        let bar_width = (w / 40.0).clamp(10.0, 28.0);
+        let bar_right = w - margin - label_width - font;
+        let bar_left = bar_right - bar_width;
+        let plot_right = bar_left - 2.0 * margin;
+        let (plot_w, plot_h) = ((plot_right - margin).max(1.0), (bottom - top).max(1.0));
+        let ([xmin, ymin], [xmax, ymax]) = mesh.bounding_box().unwrap_or(([0.0, 0.0], [1.0, 1.0]));
+        let (dx, dy) = ((xmax - xmin).max(f64::MIN_POSITIVE), (ymax - ymin).max(f64::MIN_POSITIVE));
+        let scale = (plot_w / dx).min(plot_h / dy);
+        Self {
+            x0: margin + (plot_w - dx * scale) / 2.0,
+            y0: bottom - (plot_h - dy * scale) / 2.0,
+            xmin,
+            ymin,
+            scale,
+            bar: [bar_left as i64, top as i64, bar_right as i64, bottom as i64],
+            font,
+            title_font,
+        }
+    }
+
+    fn pixel(&self, p: [f64; 2]) -> [f64; 2] {
+        [self.x0 + (p[0] - self.xmin) * self.scale, self.y0 - (p[1] - self.ymin) * self.scale]
+    }
+}
+
+/// An RGB canvas.
+struct Canvas {
+    w: i64,
+    h: i64,
+    rgb: Vec<u8>,
+}
+
+impl Canvas {
+    fn put(&mut self, x: i64, y: i64, c: [u8; 3]) {
+        if (0..self.w).contains(&x) && (0..self.h).contains(&y) {
+            let i = 3 * (y * self.w + x) as usize;
+            self.rgb[i..i + 3].copy_from_slice(&c);
+        }
+    }
+
+    fn get(&self, x: i64, y: i64) -> [u8; 3] {
+        let i = 3 * (y * self.w + x) as usize;
+        [self.rgb[i], self.rgb[i + 1], self.rgb[i + 2]]
+    }
+
+    fn rect(&mut self, [x0, y0, x1, y1]: [i64; 4], c: [u8; 3]) {
+        for y in y0.max(0)..y1.min(self.h) {
+            for x in x0.max(0)..x1.min(self.w) {
+                self.put(x, y, c);
+            }
+        }
+    }
+
+    /// Fills the pixels whose centres lie in the triangle (inclusive, so shared edges leave no gaps).
+    fn triangle(&mut self, p: [[f64; 2]; 3], c: [u8; 3]) {
+        let cross =
+            |a: [f64; 2], b: [f64; 2], q: [f64; 2]| (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0]);
+        let area = cross(p[0], p[1], p[2]);
+        if area == 0.0 || !area.is_finite() {
+            return;
+        }
+        let sign = area.signum();
+        let lo = |k: usize| (p[0][k].min(p[1][k]).min(p[2][k]) - 0.5).ceil() as i64;
+        let hi = |k: usize| (p[0][k].max(p[1][k]).max(p[2][k]) - 0.5).floor() as i64;
+        for y in lo(1).max(0)..=hi(1).min(self.h - 1) {
+            for x in lo(0).max(0)..=hi(0).min(self.w - 1) {
+                let q = [x as f64 + 0.5, y as f64 + 0.5];
+                if (0..3).all(|i| sign * cross(p[i], p[(i + 1) % 3], q) >= 0.0) {
+                    self.put(x, y, c);
+                }
+            }
+        }
+    }
+
+    /// Draws a 1-pixel line whose pixels are the `fill` canvas's colour darkened by `strength`
+    /// in [0, 1], so every edge pixel looks the same however many edges cross it.
+    fn edge(&mut self, fill: &Canvas, a: [f64; 2], b: [f64; 2], strength: f64) {
+        let shade = 1.0 - strength * (1.0 - EDGE_SHADE);
+        let steps = (b[0] - a[0]).abs().max((b[1] - a[1]).abs()).ceil().max(1.0) as usize;
+        for s in 0..=steps {
+            let t = s as f64 / steps as f64;
+            let (x, y) = ((a[0] + t * (b[0] - a[0])).floor() as i64, (a[1] + t * (b[1] - a[1])).floor() as i64);
+            if (0..self.w).contains(&x) && (0..self.h).contains(&y) {
+                self.put(x, y, fill.get(x, y).map(|v| (v as f64 * shade) as u8));
+            }
+        }
+    }
+}
+
+/// How strongly to draw the edges of a triangle (in pixels): 0 below [`EDGE_FADE`], 1 above.
+/// Thickness is the smallest height, so slivers thin in one direction count as small.
+fn edge_strength(p: [[f64; 2]; 3]) -> f64 {
+    let length = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let longest = length(p[0], p[1]).max(length(p[1], p[2])).max(length(p[2], p[0]));
+    let doubled_area = ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0])).abs();
+    let thickness = doubled_area / longest;
+    ((thickness - EDGE_FADE.0) / (EDGE_FADE.1 - EDGE_FADE.0)).clamp(0.0, 1.0)
+}
+
+/// Draws the picture into an RGB buffer and says where the mesh went; errors are text-drawing
+/// failures.
+fn render(mesh: &Mesh2, values: &[f64], options: &RenderOptions) -> Result<(Vec<u8>, Layout), String> {
+    register_default_font();
+    let (w, h) = (options.width, options.height);
+    let scale = Scale::new(values, options);
+    let ticks = scale.ticks();
+    let font_size = (h as f64 / 40.0).clamp(10.0, 20.0);
+    let text = |size: f64, pos: Pos| {
+        TextStyle::from((FONT_FAMILY, size).into_font()).color(&RGBColor(INK[0], INK[1], INK[2])).pos(pos)
+    };
+    let label_style = text(font_size, Pos::new(HPos::Left, VPos::Center));
+    let mut canvas = Canvas { w: w as i64, h: h as i64, rgb: BACKGROUND.repeat((w * h) as usize) };
+
+    // Measure the tick labels first: their width decides how much room the mesh gets.
+    let label_width = {
+        let backend = BitMapBackend::with_buffer(&mut canvas.rgb, (w, h));
+        let mut widest = 0;
+        for (_, label) in &ticks {
+            widest = widest.max(backend.estimate_text_size(label, &label_style).map_err(|e| e.to_string())?.0);
+        }
+        widest as f64
+    };
+    let layout = Layout::new(mesh, options, label_width);
+
+    let pixels: Vec<[f64; 2]> = mesh.vertices().iter().map(|&p| layout.pixel(p)).collect();
+    let corners = |cell: &[u32]| [pixels[cell[0] as usize], pixels[cell[1] as usize], pixels[cell[2] as usize]];
+    for (cell, &v) in mesh.elements().zip(values) {
+        canvas.triangle(corners(cell), scale.colour(v));
+    }
+    if options.edges {
+        // Each edge is drawn once, as strongly as the thicker of its two elements asks for.
+        let mut edges: Vec<((u32, u32), f64)> = Vec::with_capacity(3 * mesh.num_elements());
+        for cell in mesh.elements() {
+            let strength = edge_strength(corners(cell));
+            if strength > 0.0 {
+                for (a, b) in [(cell[0], cell[1]), (cell[1], cell[2]), (cell[2], cell[0])] {
+                    edges.push(((a.min(b), a.max(b)), strength));
+                }
+            }
+        }
+        edges.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
+        edges.dedup_by_key(|e| e.0);
+        let fill = Canvas { w: canvas.w, h: canvas.h, rgb: canvas.rgb.clone() };
+        for ((a, b), strength) in edges {
+            canvas.edge(&fill, pixels[a as usize], pixels[b as usize], strength);
+        }
+    }
+
+    // Colour bar: a gradient from the bottom (low) to the top (high), framed, with ticks.
+    let [left, top, right, bottom] = layout.bar;
+    let bar_height = (bottom - top - 1).max(1) as f64;
+    for y in top..bottom {
+        canvas.rect([left, y, right, y + 1], viridis((bottom - 1 - y) as f64 / bar_height));
+    }
+    for frame in [[left - 1, top - 1, right + 1, top], [left - 1, bottom, right + 1, bottom + 1]] {
+        canvas.rect(frame, INK);
+    }
+    for frame in [[left - 1, top - 1, left, bottom + 1], [right, top - 1, right + 1, bottom + 1]] {
+        canvas.rect(frame, INK);
+    }
+    let tick_y = |v: f64| bottom - 1 - (scale.position(v).unwrap_or(0.0) * bar_height).round() as i64;
+    let tick_length = (layout.font / 3.0).round() as i64;
+    for &(v, _) in &ticks {
+        canvas.rect([right, tick_y(v), right + tick_length, tick_y(v) + 1], INK);
+    }
+
+    let mut backend = BitMapBackend::with_buffer(&mut canvas.rgb, (w, h));
+    let label_x = (right + tick_length + 3) as i32;
+    for (v, label) in &ticks {
+        backend.draw_text(label, &label_style, (label_x, tick_y(*v) as i32)).map_err(|e| e.to_string())?;
+    }
+    if let Some(title) = &options.title {
+        let style = text(layout.title_font, Pos::new(HPos::Center, VPos::Top));
+        let y = (layout.title_font * 0.4) as i32;
+        backend.draw_text(title, &style, (w as i32 / 2, y)).map_err(|e| e.to_string())?;
+    }
+    backend.present().map_err(|e| e.to_string())?;
+    drop(backend);
+    Ok((canvas.rgb, layout))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn decode(path: &Path) -> (u32, u32, Vec<u8>) {
+        let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        (info.width, info.height, buf)
+    }
+
+    /// A 2×1 rectangle split into four triangles around its centre.
+    fn fan() -> Mesh2 {
+        let v = vec![[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0], [1.0, 0.5]];
+        Mesh2::new(v, vec![0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4]).unwrap()
+    }
+
+    #[test]
+    fn element_centres_have_their_colour() {
+        let dir = crate::io::test_dir("render");
+        let path = dir.join("fan.png");
+        let mesh = fan();
+        let values = [1.0, 2.0, 3.0, f64::NAN];
+        let options = RenderOptions { width: 400, height: 300, title: Some("fan".into()), ..Default::default() };
+        render_png(&mesh, &values, &options, &path).unwrap();
+        let (w, h, rgb) = decode(&path);
+        assert_eq!((w, h), (400, 300));
+        let (_, layout) = render(&mesh, &values, &options).unwrap();
+        for (e, expected) in [viridis(0.0), viridis(0.5), viridis(1.0), MISSING_COLOUR].into_iter().enumerate() {
+            let [x, y] = layout.pixel(mesh.midpoint(e));
+            let i = 3 * (y as usize * w as usize + x as usize);
+            assert_eq!(rgb[i..i + 3], expected, "element {e} at pixel ({x:.0}, {y:.0})");
+        }
+        // The mesh keeps its 2:1 aspect ratio.
+        let [x0, y0] = layout.pixel([0.0, 0.0]);
+        let [x1, y1] = layout.pixel([2.0, 1.0]);
+        assert!(((x1 - x0) / (y0 - y1) - 2.0).abs() < 1e-12);
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn bad_requests_are_errors() {
+        let path = Path::new("/nonexistent-dir/x.png");
+        let err = render_png(&fan(), &[1.0], &RenderOptions::default(), path).unwrap_err();
+        assert!(matches!(err, MeshError::DataLength { len: 1, expected: 4, .. }), "{err}");
+        let tiny = RenderOptions { width: 10, ..Default::default() };
+        assert!(matches!(render_png(&fan(), &[1.0; 4], &tiny, path), Err(MeshError::Format { .. })));
+        assert!(matches!(render_png(&fan(), &[1.0; 4], &RenderOptions::default(), path), Err(MeshError::Io { .. })));
+    }
+
+    #[test]
+    fn viridis_matches_matplotlib_anchors() {
+        // matplotlib's viridis at i/7 (as tabulated in plotters' ViridisRGB).
+        let anchors = [
+            [68, 1, 84],
+            [70, 50, 127],
+            [54, 92, 141],
+            [39, 127, 143],
+            [31, 162, 136],
+            [74, 194, 110],
+            [160, 219, 57],
+            [254, 232, 37],
+        ];
+        for (i, a) in anchors.iter().enumerate() {
+            let c = viridis(i as f64 / 7.0);
+            assert!((0..3).all(|k| (c[k] as i32 - a[k]).abs() <= 4), "{i}: {c:?} vs {a:?}");
+        }
+    }
+
+    #[test]
+    fn ticks_are_round_numbers_inside_the_range() {
+        let linear = Scale { lo: 0.013, hi: 0.087, log: false }.ticks();
+        let labels: Vec<&str> = linear.iter().map(|(_, l)| l.as_str()).collect();
+        assert_eq!(labels, ["0.02", "0.04", "0.06", "0.08"]);
+        let log = Scale { lo: 3e-5, hi: 0.2, log: true }.ticks();
+        let labels: Vec<&str> = log.iter().map(|(_, l)| l.as_str()).collect();
+        assert_eq!(labels, ["1e-4", "0.001", "0.01", "0.1"]);
+        let narrow = Scale { lo: 2.0, hi: 3.0, log: true }.ticks();
+        assert!(narrow.len() >= 2, "{narrow:?}");
+        assert!(Scale { lo: 1e-300, hi: 1e300, log: true }.ticks().len() <= 10);
+        for (lo, hi) in [(-f64::MAX, f64::MAX), (1.0, 1.0 + f64::EPSILON), (0.0, 5e-324)] {
+            assert!(Scale { lo, hi, log: false }.ticks().len() <= 10, "{lo} {hi}");
+        }
+        assert_eq!(label(-2.5e-7, -8), "-2.5e-7");
+        assert_eq!(label(1500.0, 2), "1500");
+    }
+
+    /// Release timing on 200k triangles graded towards a corner, coloured by log size:
+    /// `cargo test -p amber-mesh --release -- --ignored --nocapture render_speed`.
+    #[test]
+    #[ignore = "timing, run in release"]
+    fn render_speed() {
+        let n = 316;
+        let graded = |i: usize| (i as f64 / n as f64).powi(3);
+        let vertices: Vec<[f64; 2]> = (0..=n).flat_map(|j| (0..=n).map(move |i| [graded(i), graded(j)])).collect();
+        let mut cells = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = (j * (n + 1) + i) as u32;
+                let up = v + n as u32 + 1;
+                cells.extend([v, v + 1, up + 1, v, up + 1, up]);
+            }
+        }
+        let mesh = Mesh2::new(vertices, cells).unwrap();
+        let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
+        let path = std::env::temp_dir().join("amber-mesh-render-speed.png");
+        let start = std::time::Instant::now();
+        render_png(&mesh, &mesh.sizes(), &options, &path).unwrap();
+        println!("{} triangles rendered to {} in {:?}", mesh.num_elements(), path.display(), start.elapsed());
+    }
+}

@@ -1,0 +1,248 @@
+//! `bench-mpn`: training-step and inference throughput of the message passing network on one
+//! large random mesh-like graph, for the stock-candle composition and the fused ops, optionally
+//! next to the PyTorch peer (`shared/peers/bench_mpn.py`) run on a graph of the same size.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use amber_mpn::synthetic::random_graph;
+use amber_mpn::{GraphInput, Mpn, MpnConfig, TrainConfig, Trainer, mse};
+use anyhow::{Context, bail};
+use candle_core::{DType, Device, Tensor};
+use rand::SeedableRng;
+use rand::rngs::StdRng;
+use serde_json::{Value, json};
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Where to write the results (JSON).
+    #[arg(long, default_value = "results/bench/mpn.json")]
+    pub out: PathBuf,
+    /// Nodes of the benchmark graph.
+    #[arg(long, default_value_t = 50_000)]
+    pub nodes: usize,
+    /// Directed edges besides the self-loops (about 3 neighbours per node by default).
+    #[arg(long, default_value_t = 150_000)]
+    pub edges: usize,
+    /// Nodes for the naive variant, whose training step needs far more memory (default: --nodes).
+    #[arg(long)]
+    pub naive_nodes: Option<usize>,
+    /// Variants to time: naive (stock candle ops), fast (fused ops), fast-dropout (fused ops with
+    /// the training-mode edge dropout of 0.1).
+    #[arg(long, value_delimiter = ',', default_value = "fast,fast-dropout,naive")]
+    pub variants: Vec<String>,
+    /// Timed iterations per case (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    pub iters: usize,
+    /// Untimed iterations before timing (first touches of memory are slow).
+    #[arg(long, default_value_t = 2)]
+    pub warmup: usize,
+    /// Python interpreter with torch and torch_geometric, to also run the PyTorch peer.
+    #[arg(long)]
+    pub peer_python: Option<PathBuf>,
+    /// The peer script.
+    #[arg(long, default_value = "../shared/peers/bench_mpn.py")]
+    pub peer_script: PathBuf,
+    /// Threads for the peer (PEERS_THREADS); ours follow RAYON_NUM_THREADS (default: all cores).
+    #[arg(long, default_value_t = 2)]
+    pub peer_threads: usize,
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let config = MpnConfig::poisson();
+    let mut cases = Vec::new();
+    for variant in &args.variants {
+        let nodes = if variant == "naive" { args.naive_nodes.unwrap_or(args.nodes) } else { args.nodes };
+        let edges = args.edges * nodes / args.nodes;
+        for mode in ["infer", "train"] {
+            let case = bench_case(&config, variant, mode, nodes, edges, &args)?;
+            println!(
+                "{variant:>13} {mode:5} N={nodes:>7} E={:>7}: median {:8.1} ms  {:>8.0} nodes/s  peak RSS {:.2} GiB  [other processes {:.2} CPUs]",
+                case["n_edges"], case["s_median"].as_f64().unwrap_or(0.0) * 1e3, case["nodes_per_s"].as_f64().unwrap_or(0.0),
+                case["peak_rss_gib"].as_f64().unwrap_or(f64::NAN), case["other_cpus_median"].as_f64().unwrap_or(0.0)
+            );
+            cases.push(case);
+        }
+    }
+    let peer = match &args.peer_python {
+        Some(python) => Some(run_peer(python, &args)?),
+        None => None,
+    };
+    let result = json!({
+        "benchmark": "mpn",
+        "config": config,
+        "train": TrainConfig::default(),
+        "graph": { "nodes": args.nodes, "directed_edges": args.edges, "self_loops": args.nodes, "generator": "amber_mpn::synthetic::random_graph (uniform random pairs, both directions, dst-sorted)" },
+        "rayon_threads": rayon::current_num_threads(),
+        "candle_threads": candle_core::utils::get_num_threads(),
+        "iters": args.iters,
+        "warmup": args.warmup,
+        "machine": machine(),
+        "cases": cases,
+        "ratios": ratios(&cases, peer.as_ref()),
+        "peer": peer,
+    });
+    if let Some(dir) = args.out.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(&args.out, serde_json::to_string_pretty(&result)?).with_context(|| format!("writing {}", args.out.display()))?;
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Times one (variant, mode): `infer` is a forward of a plain-tensor model, `train` is forward,
+/// MSE, backward, global-norm clipping at 0.5 and an Adam step.
+fn bench_case(config: &MpnConfig, variant: &str, mode: &str, nodes: usize, edges: usize, args: &Args) -> anyhow::Result<Value> {
+    let dev = Device::Cpu;
+    let graph = GraphInput::from_batch(&random_graph(nodes, edges / 2, config.node_features, config.edge_features, 0), DType::F32, &dev)?;
+    // Sizing-field-like positive targets in [0.01, 0.06), deterministic.
+    let targets: Vec<f32> = (0..nodes).map(|i| 0.01 + 0.05 * ((i as f32 * 0.618_034) % 1.0)).collect();
+    let targets = Tensor::from_vec(targets, nodes, &dev)?;
+    let (model, varmap) = Mpn::init(config.clone(), 0, DType::F32, &dev)?;
+    let mut trainer = Trainer::new(&varmap, &TrainConfig::default())?;
+    let frozen = model.for_inference();
+    let mut rng = StdRng::seed_from_u64(0);
+    let mut step = || -> anyhow::Result<()> {
+        match (variant, mode) {
+            ("naive", "infer") => drop(frozen.forward_naive(&graph)?),
+            ("fast" | "fast-dropout", "infer") => drop(frozen.forward(&graph)?),
+            ("naive", _) => drop(trainer.step(&mse(&model.forward_naive(&graph)?, &targets)?)?),
+            ("fast", _) => drop(trainer.step(&mse(&model.forward(&graph)?, &targets)?)?),
+            ("fast-dropout", _) => drop(trainer.step(&mse(&model.forward_train(&graph, &mut rng)?, &targets)?)?),
+            _ => bail!("unknown variant {variant}"),
+        }
+        Ok(())
+    };
+    let peak_reset = reset_peak_rss();
+    for _ in 0..args.warmup {
+        step()?;
+    }
+    let (mut times, mut others) = (Vec::new(), Vec::new());
+    for _ in 0..args.iters.max(1) {
+        let load = CpuLoad::start();
+        let t = Instant::now();
+        step()?;
+        times.push(t.elapsed().as_secs_f64());
+        others.push(load.other_cpus());
+    }
+    let s_median = median(&times);
+    Ok(json!({
+        "variant": variant,
+        "mode": mode,
+        "n_nodes": nodes,
+        "n_edges": graph.topology.num_edges(),
+        "s_median": s_median,
+        "s_min": times.iter().copied().fold(f64::INFINITY, f64::min),
+        "s_all": times,
+        "nodes_per_s": nodes as f64 / s_median,
+        "peak_rss_gib": peak_rss_gib(),
+        "peak_rss_is_process_wide": !peak_reset,
+        "other_cpus_median": median(&others),
+    }))
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    match s.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => s[n / 2],
+        n => 0.5 * (s[n / 2 - 1] + s[n / 2]),
+    }
+}
+
+/// Resets the kernel's peak-RSS counter of this process (Linux `clear_refs` 5).
+fn reset_peak_rss() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+fn peak_rss_gib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib: f64 = status.lines().find(|l| l.starts_with("VmHWM:"))?.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / (1024.0 * 1024.0))
+}
+
+/// CPUs used by other processes while a case runs: the machine's busy time from `/proc/stat`
+/// minus this process's own from `/proc/self/stat`, as in the peer benchmarks.
+struct CpuLoad {
+    busy: u64,
+    total: u64,
+    own: u64,
+}
+
+impl CpuLoad {
+    fn read() -> Option<(u64, u64, u64)> {
+        let stat = std::fs::read_to_string("/proc/stat").ok()?;
+        let v: Vec<u64> = stat.lines().next()?.split_whitespace().skip(1).filter_map(|x| x.parse().ok()).collect();
+        let total: u64 = v.iter().sum();
+        let busy = total - v.get(3)? - v.get(4)?;
+        let own_stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+        let fields: Vec<&str> = own_stat.rsplit_once(')')?.1.split_whitespace().collect();
+        let own = fields.get(11)?.parse::<u64>().ok()? + fields.get(12)?.parse::<u64>().ok()?;
+        Some((busy, total, own))
+    }
+
+    fn start() -> Self {
+        let (busy, total, own) = Self::read().unwrap_or_default();
+        Self { busy, total, own }
+    }
+
+    fn other_cpus(&self) -> f64 {
+        let Some((busy, total, own)) = Self::read() else { return f64::NAN };
+        let cpus = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+        let other = (busy - self.busy) as f64 - (own - self.own) as f64;
+        (other / (total - self.total).max(1) as f64 * cpus).max(0.0)
+    }
+}
+
+fn machine() -> Value {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_owned()));
+    json!({ "cpu_model": cpu, "cpus": std::thread::available_parallelism().map_or(1, |n| n.get()) })
+}
+
+/// Runs the PyTorch peer (plain and PyG aggregation) on a graph of the same size, with self-loops,
+/// and returns its JSON.
+fn run_peer(python: &Path, args: &Args) -> anyhow::Result<Value> {
+    let results = std::env::temp_dir().join(format!("amber-peer-mpn-{}", std::process::id()));
+    let status = Command::new(python)
+        .arg(&args.peer_script)
+        .args(["--sizes", &args.nodes.to_string(), "--variants", "plain,pyg", "--ckpt-sizes", "", "--self-loops"])
+        .args(["--steps", &args.iters.to_string()])
+        .env("PEERS_RESULTS", &results)
+        .env("PEERS_THREADS", args.peer_threads.to_string())
+        .env("PEERS_OMP_WAIT_POLICY", "PASSIVE")
+        .status()
+        .with_context(|| format!("running {} {}", python.display(), args.peer_script.display()))?;
+    if !status.success() {
+        bail!("the peer benchmark failed: {status}");
+    }
+    let path = results.join("mpn.json");
+    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    std::fs::remove_dir_all(&results).ok();
+    Ok(serde_json::from_str(&text)?)
+}
+
+/// Speed-ups of the fused variant over the naive one and over each peer case.
+fn ratios(cases: &[Value], peer: Option<&Value>) -> Value {
+    let rate = |cs: &[Value], variant: &str, mode: &str| {
+        cs.iter().find(|c| c["variant"] == variant && c["mode"] == mode && c["status"] != "skipped").and_then(|c| c["nodes_per_s"].as_f64())
+    };
+    let mut out = serde_json::Map::new();
+    for mode in ["train", "infer"] {
+        let Some(fast) = rate(cases, "fast", mode) else { continue };
+        if let Some(naive) = rate(cases, "naive", mode) {
+            out.insert(format!("fast_over_naive_{mode}"), json!(fast / naive));
+        }
+        if let Some(peer_cases) = peer.and_then(|p| p["cases"].as_array()) {
+            for v in ["plain", "pyg"] {
+                if let Some(p) = rate(peer_cases, v, mode) {
+                    out.insert(format!("fast_over_torch_{v}_{mode}"), json!(fast / p));
+                }
+            }
+        }
+    }
+    Value::Object(out)
+}
