@@ -521,28 +521,4 @@ mod tests {
         assert_eq!(label(-2.5e-7, -8), "-2.5e-7");
         assert_eq!(label(1500.0, 2), "1500");
     }
-
-    /// Release timing on 200k triangles graded towards a corner, coloured by log size:
-    /// `cargo test -p amber-mesh --release -- --ignored --nocapture render_speed`.
-    #[test]
-    #[ignore = "timing, run in release"]
-    fn render_speed() {
-        let n = 316;
-        let graded = |i: usize| (i as f64 / n as f64).powi(3);
-        let vertices: Vec<[f64; 2]> = (0..=n).flat_map(|j| (0..=n).map(move |i| [graded(i), graded(j)])).collect();
-        let mut cells = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                let v = (j * (n + 1) + i) as u32;
-                let up = v + n as u32 + 1;
-                cells.extend([v, v + 1, up + 1, v, up + 1, up]);
-            }
-        }
-        let mesh = Mesh2::new(vertices, cells).unwrap();
-        let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
-        let path = std::env::temp_dir().join("amber-mesh-render-speed.png");
-        let start = std::time::Instant::now();
-        render_png(&mesh, &mesh.sizes(), &options, &path).unwrap();
-        println!("{} triangles rendered to {} in {:?}", mesh.num_elements(), path.display(), start.elapsed());
-    }
 }
