@@ -32,8 +32,13 @@ fn graded_field(scale: f64) -> impl Fn([f64; 2]) -> f64 + Sync {
 struct Case {
     name: String,
     triangles: usize,
+    /// Median wall time.
     seconds: f64,
     triangles_per_second: f64,
+    /// CPU time of the meshing thread in the same run (10 ms resolution): the wall time
+    /// without the share lost to other processes on a busy machine.
+    cpu_seconds: f64,
+    triangles_per_cpu_second: f64,
     quality: QualityReport,
 }
 
@@ -42,23 +47,24 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut cases = Vec::new();
     for (name, scale) in [("graded-10k", 0.21), ("graded-100k", 0.0666), ("graded-1M", 0.021)] {
         let field = FnSize(graded_field(scale));
-        let (mesh, seconds) = median_time(args.repeats, || generate_2d(&domain, &field, &Mesh2dParams::default()))?;
-        cases.push(case(name, &mesh, seconds, QualityReport::measure(&mesh, &field)));
+        let (mesh, seconds, cpu) = median_time(args.repeats, || generate_2d(&domain, &field, &Mesh2dParams::default()))?;
+        cases.push(case(name, &mesh, seconds, cpu, QualityReport::measure(&mesh, &field)));
     }
     for (name, triangles) in [("spade-refine-uniform-10k", 1e4), ("spade-refine-uniform-100k", 1e5), ("spade-refine-uniform-1M", 1e6)] {
         let max_area = 1.5 * domain.area() / triangles;
-        let (mesh, seconds) = median_time(args.repeats, || spade_uniform(&domain, max_area))?;
+        let (mesh, seconds, cpu) = median_time(args.repeats, || spade_uniform(&domain, max_area))?;
         // Sizes measured against the regular triangle of half the area cap (refine's typical area).
         let target = amber_mesh::size_from_volume::<2>(0.5 * max_area);
-        cases.push(case(name, &mesh, seconds, QualityReport::measure(&mesh, &ConstantSize(target))));
+        cases.push(case(name, &mesh, seconds, cpu, QualityReport::measure(&mesh, &ConstantSize(target))));
     }
     for c in &cases {
         println!(
-            "{:<28} {:>9} tris {:>8.3} s {:>10.0} tris/s  size ratio {:.3} [{:.3}, {:.3}]  min angle {:.1}°  mean min angle {:.1}°",
+            "{:<28} {:>9} tris {:>8.3} s {:>10.0} tris/s ({:>8.0} per CPU s)  size ratio {:.3} [{:.3}, {:.3}]  min angle {:.1}°  mean min angle {:.1}°",
             c.name,
             c.triangles,
             c.seconds,
             c.triangles_per_second,
+            c.triangles_per_cpu_second,
             c.quality.size_ratio_median,
             c.quality.size_ratio_p10,
             c.quality.size_ratio_p90,
@@ -69,21 +75,43 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     write_json(&args.out, &serde_json::json!({ "benchmark": "mesher", "settings": args, "machine": crate::report::machine(), "cases": cases }))
 }
 
-fn case(name: &str, mesh: &Mesh2, seconds: f64, quality: QualityReport) -> Case {
-    Case { name: name.into(), triangles: mesh.num_elements(), seconds, triangles_per_second: mesh.num_elements() as f64 / seconds, quality }
+fn case(name: &str, mesh: &Mesh2, seconds: f64, cpu_seconds: f64, quality: QualityReport) -> Case {
+    let triangles = mesh.num_elements();
+    Case {
+        name: name.into(),
+        triangles,
+        seconds,
+        triangles_per_second: triangles as f64 / seconds,
+        cpu_seconds,
+        triangles_per_cpu_second: triangles as f64 / cpu_seconds,
+        quality,
+    }
 }
 
-/// Runs `make` `repeats` times and returns its last result and the median wall time.
-fn median_time<T, E: Into<anyhow::Error>>(repeats: usize, mut make: impl FnMut() -> Result<T, E>) -> anyhow::Result<(T, f64)> {
-    let mut times = Vec::new();
+/// Runs `make` `repeats` times; returns its last result and the median wall and thread-CPU times.
+fn median_time<T, E: Into<anyhow::Error>>(repeats: usize, mut make: impl FnMut() -> Result<T, E>) -> anyhow::Result<(T, f64, f64)> {
+    let mut wall = Vec::new();
+    let mut cpu = Vec::new();
     let mut last = None;
     for _ in 0..repeats.max(1) {
-        let start = Instant::now();
+        let (start, cpu_start) = (Instant::now(), thread_cpu_seconds());
         last = Some(make().map_err(Into::into)?);
-        times.push(start.elapsed().as_secs_f64());
+        wall.push(start.elapsed().as_secs_f64());
+        cpu.push(thread_cpu_seconds() - cpu_start);
     }
-    times.sort_by(f64::total_cmp);
-    Ok((last.expect("at least one repetition"), times[times.len() / 2]))
+    wall.sort_by(f64::total_cmp);
+    cpu.sort_by(f64::total_cmp);
+    Ok((last.expect("at least one repetition"), wall[wall.len() / 2], cpu[cpu.len() / 2].max(0.01)))
+}
+
+/// User + system CPU time of the calling thread, from /proc (clock ticks of 10 ms).
+fn thread_cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").unwrap_or_default();
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = stat.rsplit_once(')').map(|(_, r)| r).unwrap_or("");
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / 100.0
 }
 
 /// spade's built-in refinement: a uniform area bound, 20° angle limit, notch excluded.

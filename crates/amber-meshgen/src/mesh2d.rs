@@ -41,7 +41,7 @@ pub struct Mesh2dParams {
 
 impl Default for Mesh2dParams {
     fn default() -> Self {
-        Self { max_elements: 5_000_000, size_factor: 0.78, min_angle_deg: 25.0, quality_floor: 0.5, smoothing_passes: 3 }
+        Self { max_elements: 5_000_000, size_factor: 0.78, min_angle_deg: 25.0, quality_floor: 0.5, smoothing_passes: 2 }
     }
 }
 
