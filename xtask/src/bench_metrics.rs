@@ -14,7 +14,6 @@ use std::time::Instant;
 use amber_graph::{Aggregation, project_expert_sizing};
 use amber_mesh::Mesh2;
 use amber_metrics::point_set_distance;
-use anyhow::Context;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use serde::Serialize;
@@ -66,9 +65,8 @@ struct Case {
 struct Report<'a> {
     benchmark: &'static str,
     settings: &'a Args,
-    available_parallelism: Option<usize>,
-    /// 1-minute load average when the run ended (Linux): timings on a busy machine are inflated.
-    load_average: Option<f64>,
+    /// CPU, cores and load average: timings on a busy machine are inflated.
+    machine: serde_json::Value,
     cases: Vec<Case>,
 }
 
@@ -109,25 +107,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             c.name, c.median_s, c.single_thread_median_s, c.speedup
         );
     }
-    if let Some(dir) = args.out.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let report = Report {
-        benchmark: "metrics",
-        settings: &args,
-        available_parallelism: std::thread::available_parallelism().ok().map(usize::from),
-        load_average: std::fs::read_to_string("/proc/loadavg")
-            .ok()
-            .and_then(|s| s.split_whitespace().next()?.parse().ok()),
-        cases,
-    };
-    if let Some(load) = report.load_average {
-        println!("load average {load:.2} on {} threads", report.available_parallelism.unwrap_or(0));
-    }
-    std::fs::write(&args.out, serde_json::to_string_pretty(&report)?)
-        .with_context(|| format!("writing {}", args.out.display()))?;
-    println!("wrote {}", args.out.display());
-    Ok(())
+    let report = Report { benchmark: "metrics", settings: &args, machine: crate::report::machine(), cases };
+    crate::report::write_json(&args.out, &report)
 }
 
 /// Times `work` `repeats` times on `threads` threads and on one thread (after one warm-up run).

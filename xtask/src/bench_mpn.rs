@@ -28,10 +28,13 @@ pub struct Args {
     /// Nodes for the naive variant, whose training step needs far more memory (default: --nodes).
     #[arg(long)]
     pub naive_nodes: Option<usize>,
-    /// Variants to time: naive (stock candle ops), fast (fused ops), fast-dropout (fused ops with
-    /// the training-mode edge dropout of 0.1).
+    /// Variants to time: naive (stock candle ops), fast (fused ops), fast-dropout (training step of
+    /// the fused ops with the training-mode edge dropout of 0.1).
     #[arg(long, value_delimiter = ',', default_value = "fast,fast-dropout,naive")]
     pub variants: Vec<String>,
+    /// Modes to time: infer (forward of a plain-tensor model), train (forward, backward, clip, Adam).
+    #[arg(long, value_delimiter = ',', default_value = "infer,train")]
+    pub modes: Vec<String>,
     /// Timed iterations per case (the median is reported).
     #[arg(long, default_value_t = 5)]
     pub iters: usize,
@@ -55,11 +58,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for variant in &args.variants {
         let nodes = if variant == "naive" { args.naive_nodes.unwrap_or(args.nodes) } else { args.nodes };
         let edges = args.edges * nodes / args.nodes;
-        for mode in ["infer", "train"] {
+        // Dropout only exists in training.
+        for mode in args.modes.iter().filter(|m| !(variant == "fast-dropout" && *m == "infer")) {
             let case = bench_case(&config, variant, mode, nodes, edges, &args)?;
             println!(
-                "{variant:>13} {mode:5} N={nodes:>7} E={:>7}: median {:8.1} ms  {:>8.0} nodes/s  peak RSS {:.2} GiB  [other processes {:.2} CPUs]",
-                case["n_edges"], case["s_median"].as_f64().unwrap_or(0.0) * 1e3, case["nodes_per_s"].as_f64().unwrap_or(0.0),
+                "{variant:>13} {mode:5} N={nodes:>7} E={:>7}: median {:8.1} ms  {:>8.0} nodes/s  (CPU {:6.1} s)  peak RSS {:.2} GiB  [other processes {:.2} CPUs]",
+                case["n_edges"], case["s_median"].as_f64().unwrap_or(0.0) * 1e3, case["nodes_per_s"].as_f64().unwrap_or(0.0), case["cpu_s_median"].as_f64().unwrap_or(0.0),
                 case["peak_rss_gib"].as_f64().unwrap_or(f64::NAN), case["other_cpus_median"].as_f64().unwrap_or(0.0)
             );
             cases.push(case);
@@ -106,11 +110,11 @@ fn bench_case(config: &MpnConfig, variant: &str, mode: &str, nodes: usize, edges
     let mut step = || -> anyhow::Result<()> {
         match (variant, mode) {
             ("naive", "infer") => drop(frozen.forward_naive(&graph)?),
-            ("fast" | "fast-dropout", "infer") => drop(frozen.forward(&graph)?),
-            ("naive", _) => drop(trainer.step(&mse(&model.forward_naive(&graph)?, &targets)?)?),
-            ("fast", _) => drop(trainer.step(&mse(&model.forward(&graph)?, &targets)?)?),
-            ("fast-dropout", _) => drop(trainer.step(&mse(&model.forward_train(&graph, &mut rng)?, &targets)?)?),
-            _ => bail!("unknown variant {variant}"),
+            ("fast", "infer") => drop(frozen.forward(&graph)?),
+            ("naive", "train") => drop(trainer.step(&mse(&model.forward_naive(&graph)?, &targets)?)?),
+            ("fast", "train") => drop(trainer.step(&mse(&model.forward(&graph)?, &targets)?)?),
+            ("fast-dropout", "train") => drop(trainer.step(&mse(&model.forward_train(&graph, &mut rng)?, &targets)?)?),
+            _ => bail!("unknown variant/mode {variant}/{mode}"),
         }
         Ok(())
     };
@@ -118,12 +122,13 @@ fn bench_case(config: &MpnConfig, variant: &str, mode: &str, nodes: usize, edges
     for _ in 0..args.warmup {
         step()?;
     }
-    let (mut times, mut others) = (Vec::new(), Vec::new());
+    let (mut times, mut cpu, mut others) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..args.iters.max(1) {
         let load = CpuLoad::start();
         let t = Instant::now();
         step()?;
         times.push(t.elapsed().as_secs_f64());
+        cpu.push(load.own_cpu_s());
         others.push(load.other_cpus());
     }
     let s_median = median(&times);
@@ -135,6 +140,7 @@ fn bench_case(config: &MpnConfig, variant: &str, mode: &str, nodes: usize, edges
         "s_median": s_median,
         "s_min": times.iter().copied().fold(f64::INFINITY, f64::min),
         "s_all": times,
+        "cpu_s_median": median(&cpu),
         "nodes_per_s": nodes as f64 / s_median,
         "peak_rss_gib": peak_rss_gib(),
         "peak_rss_is_process_wide": !peak_reset,
@@ -165,6 +171,8 @@ fn peak_rss_gib() -> Option<f64> {
 
 /// CPUs used by other processes while a case runs: the machine's busy time from `/proc/stat`
 /// minus this process's own from `/proc/self/stat`, as in the peer benchmarks.
+const CLOCK_TICKS_PER_S: f64 = 100.0;
+
 struct CpuLoad {
     busy: u64,
     total: u64,
@@ -186,6 +194,11 @@ impl CpuLoad {
     fn start() -> Self {
         let (busy, total, own) = Self::read().unwrap_or_default();
         Self { busy, total, own }
+    }
+
+    /// CPU seconds (user + system, all threads) this process used since `start`.
+    fn own_cpu_s(&self) -> f64 {
+        Self::read().map_or(f64::NAN, |(_, _, own)| (own - self.own) as f64 / CLOCK_TICKS_PER_S)
     }
 
     fn other_cpus(&self) -> f64 {

@@ -4,6 +4,7 @@
 //! and the machine beside the numbers.
 
 mod bench_mesher;
+mod bench_metrics;
 mod report;
 
 use clap::{Parser, Subcommand};
@@ -26,6 +27,8 @@ enum Command {
 enum Bench {
     /// The 2D generator on a graded L-shape at ~10k/100k/1M triangles, next to spade's refine().
     Mesher(bench_mesher::Args),
+    /// DCD of 1M vs 1M points and the 42k → 5k label projection.
+    Metrics(bench_metrics::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -33,5 +36,6 @@ fn main() -> anyhow::Result<()> {
     std::env::set_current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))?;
     match Cli::parse().command {
         Command::Bench(Bench::Mesher(args)) => bench_mesher::run(args),
+        Command::Bench(Bench::Metrics(args)) => bench_metrics::run(args),
     }
 }
