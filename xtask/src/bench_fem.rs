@@ -101,7 +101,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let rhs = space.load_vector(&space.sample_load(&sample.load, &quadrature)?);
             Ok((space.stiffness(), rhs))
         };
-        let ((stiffness, rhs), assemble_seconds, _) = median_time(args.repeats, || parallel.install(|| assemble(&mesh)))?;
+        let ((stiffness, rhs), assemble_seconds, _) =
+            median_time(args.repeats, || parallel.install(|| assemble(&mesh)))?;
         let (_, single_thread_assemble_seconds, _) = median_time(args.repeats, || one.install(|| assemble(&mesh)))?;
         let (x, solve_seconds, _) = median_time(args.repeats, || stiffness.solve(&rhs))?;
         let case = SolveCase {
@@ -116,7 +117,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         };
         println!(
             "{:>9} triangles, {:>7} dofs: assemble {:.3} s ({} threads; 1 thread {:.3} s), solve {:.3} s, residual {:.1e}",
-            case.triangles, case.dofs, assemble_seconds, args.threads, single_thread_assemble_seconds, solve_seconds, case.relative_residual
+            case.triangles,
+            case.dofs,
+            assemble_seconds,
+            args.threads,
+            single_thread_assemble_seconds,
+            solve_seconds,
+            case.relative_residual
         );
         solve_cases.push(case);
     }
@@ -144,7 +151,10 @@ fn grid(n: usize) -> anyhow::Result<Mesh2> {
 }
 
 /// Runs `make` `repeats` times; returns its last result and the median wall and process-CPU times.
-fn median_time<T, E: Into<anyhow::Error>>(repeats: usize, mut make: impl FnMut() -> Result<T, E>) -> anyhow::Result<(T, f64, f64)> {
+fn median_time<T, E: Into<anyhow::Error>>(
+    repeats: usize,
+    mut make: impl FnMut() -> Result<T, E>,
+) -> anyhow::Result<(T, f64, f64)> {
     let (mut wall, mut cpu, mut last) = (Vec::new(), Vec::new(), None);
     for _ in 0..repeats.max(1) {
         let (start, cpu_start) = (Instant::now(), process_cpu_seconds());

@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 use amber_fem::{ExpertHeuristic, P1Space, Quadrature, element_stats};
 use amber_mesh::{RenderOptions, render_png};
-use amber_tasks::poisson::{DatasetManifest, Difficulty, INITIAL_SIZE, PoissonProblem, Split, SplitRequest, read_split, write_split};
+use amber_tasks::poisson::{
+    DatasetManifest, Difficulty, INITIAL_SIZE, PoissonProblem, Split, SplitRequest, read_split, write_split,
+};
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -58,9 +60,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     let manifest = DatasetManifest::read(&args.manifest)?;
     let dir = match (args.split, args.seed) {
-        (Split::Train, seed) => args.out.join(args.difficulty.name()).join("train").join(format!("seed{}", seed.unwrap_or(0))),
+        (Split::Train, seed) => {
+            args.out.join(args.difficulty.name()).join("train").join(format!("seed{}", seed.unwrap_or(0)))
+        }
         (split, None) => args.out.join(args.difficulty.name()).join(split.name()),
-        (split, Some(_)) => bail!("--seed selects training problems; the {split} split has a fixed seed in {}", args.manifest.display()),
+        (split, Some(_)) => {
+            bail!("--seed selects training problems; the {split} split has a fixed seed in {}", args.manifest.display())
+        }
     };
     let (split_seed, size) = manifest.split(args.split, args.seed.unwrap_or(0), &args.manifest)?;
     let request = SplitRequest {
@@ -71,7 +77,8 @@ fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
         heuristic: ExpertHeuristic::default(),
     };
     let bar = ProgressBar::new(request.count as u64).with_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {elapsed_precise} (eta {eta})")?.progress_chars("=> "),
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {elapsed_precise} (eta {eta})")?
+            .progress_chars("=> "),
     );
     bar.set_message(format!("{} {} (split seed {split_seed})", args.difficulty, args.split));
     let report = write_split(&request, &dir, &|| bar.inc(1))?;
@@ -81,9 +88,11 @@ fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     let problems = read_split(&dir)?;
     let counts: Vec<usize> = problems.iter().take(request.count).map(|p| p.expert_mesh.num_elements()).collect();
     let initial: Vec<usize> = problems.iter().take(request.count).map(|p| p.initial_mesh.num_elements()).collect();
-    if let (Some(min), Some(max)) = (counts.iter().min(), counts.iter().max()) {
+    if let (Some(min), Some(max), Some(min0), Some(max0)) =
+        (counts.iter().min(), counts.iter().max(), initial.iter().min(), initial.iter().max())
+    {
         let mean = counts.iter().sum::<usize>() as f64 / counts.len() as f64;
-        println!("expert triangles: mean {mean:.0}, min {min}, max {max}; initial triangles {:?}–{:?}", initial.iter().min(), initial.iter().max());
+        println!("expert triangles: mean {mean:.0}, min {min}, max {max}; initial triangles {min0}–{max0}");
     }
     for (k, problem) in problems.iter().take(args.gallery).enumerate() {
         let path = dir.join("gallery").join(format!("{k:03}.png"));
@@ -100,8 +109,14 @@ fn render_solution(problem: &PoissonProblem, name: &str, path: &Path) -> anyhow:
     let quadrature = Quadrature::simplex::<2>(2)?;
     let solution = space.solve_poisson(&space.sample_load(&problem.load, &quadrature)?)?;
     let means: Vec<f64> = element_stats(mesh, &solution.u)?.iter().map(|s| s.mean).collect();
-    std::fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).with_context(|| format!("{}: cannot create", path.display()))?;
+    std::fs::create_dir_all(path.parent().unwrap_or(Path::new(".")))
+        .with_context(|| format!("{}: cannot create", path.display()))?;
     let title = format!("{name}: {} triangles, element mean of u", mesh.num_elements());
-    render_png(mesh, &means, &RenderOptions { title: Some(title), width: 900, height: 800, ..Default::default() }, path)?;
+    render_png(
+        mesh,
+        &means,
+        &RenderOptions { title: Some(title), width: 900, height: 800, ..Default::default() },
+        path,
+    )?;
     Ok(())
 }

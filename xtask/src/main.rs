@@ -3,8 +3,10 @@
 //! Every command writes its results atomically under `results/` (or `--out`), with the settings
 //! and the machine beside the numbers.
 
+mod bench_fem;
 mod bench_mesher;
 mod bench_metrics;
+mod dataset;
 mod report;
 
 use clap::{Parser, Subcommand};
@@ -21,6 +23,8 @@ enum Command {
     /// Speed and quality benchmarks; each writes a JSON file under results/bench/.
     #[command(subcommand)]
     Bench(Bench),
+    /// Generate a dataset split under data/ (cached: existing identical files are kept).
+    Dataset(dataset::Args),
 }
 
 #[derive(Subcommand)]
@@ -29,6 +33,8 @@ enum Bench {
     Mesher(bench_mesher::Args),
     /// DCD of 1M vs 1M points and the 42k → 5k label projection.
     Metrics(bench_metrics::Args),
+    /// P1 Poisson: one hard 75-step expert run, assemble + solve at ~200k and ~1M triangles.
+    Fem(bench_fem::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -37,5 +43,7 @@ fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Bench(Bench::Mesher(args)) => bench_mesher::run(args),
         Command::Bench(Bench::Metrics(args)) => bench_metrics::run(args),
+        Command::Bench(Bench::Fem(args)) => bench_fem::run(args),
+        Command::Dataset(args) => dataset::run(args),
     }
 }

@@ -9,7 +9,7 @@
 //! split edges become 4 (red), longest + one other 3 (blue), longest only 2 (green). New vertices
 //! sit at edge midpoints and are numbered after the old ones in lexicographic edge order.
 
-use amber_mesh::{FacetAdjacency, Mesh, Mesh2, MeshError};
+use amber_mesh::{Mesh2, MeshError, signed_volume};
 
 /// Why a refinement or smoothing step failed.
 #[derive(Debug, thiserror::Error)]
@@ -24,8 +24,9 @@ pub enum RgbError {
     /// A child triangle came out degenerate in floating point (a parent thinner than round-off).
     #[error("refinement produced a degenerate element: {0}")]
     Refinement(MeshError),
-    /// Smoothing moved a vertex so far that an element turned over.
-    #[error("Laplacian smoothing inverted an element: {0}")]
+    /// Smoothing produced an invalid mesh (cannot happen for a valid input: moves that would
+    /// invert an element are undone).
+    #[error("Laplacian smoothing produced an invalid element: {0}")]
     Smoothing(MeshError),
 }
 
@@ -51,7 +52,7 @@ pub fn refine_rgb(mesh: &Mesh2, marked: &[usize]) -> Result<Mesh2, RgbError> {
     }
     let p = mesh.vertices();
     let t: Vec<[u32; 3]> = mesh.elements().map(|c| longest_edge_last(p, [c[0], c[1], c[2]])).collect();
-    let edges = EdgeTable::new(&t)?;
+    let edges = EdgeTable::new(&t, p.len())?;
 
     let mut split = vec![false; edges.len()];
     let mut queue: Vec<u32> = Vec::new();
@@ -106,40 +107,48 @@ pub fn refine_rgb(mesh: &Mesh2, marked: &[usize]) -> Result<Mesh2, RgbError> {
 /// One Jacobi sweep of Laplacian smoothing: every vertex not on the boundary moves to the mean of
 /// its edge neighbours' old positions (scikit-fem `Mesh.smoothed()`); boundary vertices stay.
 ///
-/// There is no quality guard (as in the reference): an element that turns over is an error.
-pub fn smooth_laplacian<const D: usize>(mesh: &Mesh<D>) -> Result<Mesh<D>, RgbError> {
-    let boundary = FacetAdjacency::new(mesh).map_err(RgbError::NonConforming)?.boundary_vertices(mesh);
+/// One guard the reference lacks: scikit-fem lets a sweep turn thin elements over (and then
+/// integrates with |det J|), but our meshes stay positively oriented, so the vertices of every
+/// element the sweep would invert or flatten keep their old positions (repeated until no element
+/// does; the unmoved mesh is valid, so this ends). Elsewhere the sweep is exactly the reference's.
+pub fn smooth_laplacian(mesh: &Mesh2) -> Result<Mesh2, RgbError> {
+    let t: Vec<[u32; 3]> = mesh.elements().map(|c| [c[0], c[1], c[2]]).collect();
+    let edges = EdgeTable::new(&t, mesh.num_vertices())?;
     let old = mesh.vertices();
-    let mut sum = vec![[0.0; D]; old.len()];
+    let mut boundary = vec![false; old.len()];
+    let mut sum = vec![[0.0; 2]; old.len()];
     let mut count = vec![0u32; old.len()];
-    for [a, b] in unique_edges(mesh) {
+    for (&[a, b], owners) in edges.vertices.iter().zip(&edges.e2t) {
         let (a, b) = (a as usize, b as usize);
-        for k in 0..D {
+        if owners[1] == u32::MAX {
+            boundary[a] = true;
+            boundary[b] = true;
+        }
+        for k in 0..2 {
             sum[a][k] += old[b][k];
             sum[b][k] += old[a][k];
         }
         count[a] += 1;
         count[b] += 1;
     }
-    let vertices = (0..old.len())
+    let mut vertices: Vec<[f64; 2]> = (0..old.len())
         .map(|v| if boundary[v] || count[v] == 0 { old[v] } else { sum[v].map(|s| s / f64::from(count[v])) })
         .collect();
-    Mesh::new(vertices, mesh.cells().to_vec()).map_err(RgbError::Smoothing)
-}
-
-/// Every edge of the mesh once, as sorted vertex pairs in lexicographic order.
-fn unique_edges<const D: usize>(mesh: &Mesh<D>) -> Vec<[u32; 2]> {
-    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(mesh.num_elements() * D * (D + 1) / 2);
-    for cell in mesh.elements() {
-        for i in 0..=D {
-            for j in i + 1..=D {
-                edges.push([cell[i].min(cell[j]), cell[i].max(cell[j])]);
+    loop {
+        let mut reverted = false;
+        for cell in mesh.elements() {
+            if signed_volume::<2>(&vertices, cell) <= 0.0 {
+                for &v in cell {
+                    reverted |= vertices[v as usize] != old[v as usize];
+                    vertices[v as usize] = old[v as usize];
+                }
             }
         }
+        if !reverted {
+            break;
+        }
     }
-    edges.sort_unstable();
-    edges.dedup();
-    edges
+    Mesh2::new(vertices, mesh.cells().to_vec()).map_err(RgbError::Smoothing)
 }
 
 /// Relabels a triangle, from ascending vertex order, so that (0, 2) is its longest edge; strict
@@ -170,37 +179,56 @@ fn oriented(p: &[[f64; 2]], [a, b, c]: [u32; 3]) -> [u32; 3] {
 struct EdgeTable {
     /// Sorted vertex pair of each edge.
     vertices: Vec<[u32; 2]>,
-    /// Edges (0,1), (1,2), (0,2) of each relabelled triangle.
+    /// Edges (0,1), (1,2), (0,2) of each triangle.
     t2e: Vec<[u32; 3]>,
     /// The one or two triangles of each edge (`u32::MAX` pads boundary edges).
     e2t: Vec<[u32; 2]>,
 }
 
 impl EdgeTable {
-    fn new(t: &[[u32; 3]]) -> Result<Self, RgbError> {
-        let mut keyed: Vec<([u32; 2], u32)> = Vec::with_capacity(3 * t.len());
-        for (e, tri) in t.iter().enumerate() {
-            for (slot, (i, j)) in [(0, 1), (1, 2), (0, 2)].into_iter().enumerate() {
-                let (a, b) = (tri[i].min(tri[j]), tri[i].max(tri[j]));
-                keyed.push(([a, b], (3 * e + slot) as u32));
+    /// Buckets the edge slots by their smaller vertex (counting sort), then sorts each small
+    /// bucket by the larger vertex: lexicographic edge order in linear time.
+    fn new(t: &[[u32; 3]], num_vertices: usize) -> Result<Self, RgbError> {
+        const LOCAL: [(usize, usize); 3] = [(0, 1), (1, 2), (0, 2)];
+        let key = |tri: &[u32; 3], (i, j): (usize, usize)| (tri[i].min(tri[j]), tri[i].max(tri[j]));
+        let mut offsets = vec![0u32; num_vertices + 1];
+        for tri in t {
+            for local in LOCAL {
+                offsets[key(tri, local).0 as usize + 1] += 1;
             }
         }
-        keyed.sort_unstable();
-        let mut vertices = Vec::with_capacity(keyed.len() / 2 + 1);
+        for v in 0..num_vertices {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut fill = offsets.clone();
+        let mut bucket = vec![(0u32, 0u32); 3 * t.len()];
+        for (e, tri) in t.iter().enumerate() {
+            for (slot, local) in LOCAL.into_iter().enumerate() {
+                let (a, b) = key(tri, local);
+                bucket[fill[a as usize] as usize] = (b, (3 * e + slot) as u32);
+                fill[a as usize] += 1;
+            }
+        }
+        let mut vertices = Vec::with_capacity(3 * t.len() / 2 + 1);
         let mut t2e = vec![[0u32; 3]; t.len()];
-        let mut e2t: Vec<[u32; 2]> = Vec::with_capacity(keyed.len() / 2 + 1);
-        for group in keyed.chunk_by(|x, y| x.0 == y.0) {
-            if group.len() > 2 {
-                return Err(RgbError::NonConforming(MeshError::NonManifoldFacet { facet: group[0].0.to_vec() }));
+        let mut e2t: Vec<[u32; 2]> = Vec::with_capacity(3 * t.len() / 2 + 1);
+        for a in 0..num_vertices {
+            let slots = &mut bucket[offsets[a] as usize..offsets[a + 1] as usize];
+            slots.sort_unstable();
+            for group in slots.chunk_by(|x, y| x.0 == y.0) {
+                if group.len() > 2 {
+                    let facet = vec![a as u32, group[0].0];
+                    return Err(RgbError::NonConforming(MeshError::NonManifoldFacet { facet }));
+                }
+                let edge = vertices.len() as u32;
+                vertices.push([a as u32, group[0].0]);
+                let mut owners = [u32::MAX; 2];
+                for (k, &(_, slot)) in group.iter().enumerate() {
+                    t2e[slot as usize / 3][slot as usize % 3] = edge;
+                    owners[k] = slot / 3;
+                }
+                e2t.push(owners);
             }
-            let edge = vertices.len() as u32;
-            vertices.push(group[0].0);
-            let mut owners = [u32::MAX; 2];
-            for (k, &(_, slot)) in group.iter().enumerate() {
-                t2e[slot as usize / 3][slot as usize % 3] = edge;
-                owners[k] = slot / 3;
-            }
-            e2t.push(owners);
         }
         Ok(Self { vertices, t2e, e2t })
     }
@@ -217,6 +245,7 @@ impl EdgeTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use amber_mesh::FacetAdjacency;
     use proptest::prelude::*;
 
     /// An `n × n` grid of the unit square, each cell cut along a diagonal.
@@ -347,6 +376,27 @@ mod tests {
         let c = s.vertices()[4];
         assert!((c[0] - 0.5).abs() < 1e-15 && (c[1] - 0.5).abs() < 1e-15);
         assert_eq!(&s.vertices()[..4], &m.vertices()[..4]);
+    }
+
+    #[test]
+    fn smoothing_never_inverts_an_element() {
+        // A fan around vertex 0 whose neighbour mean lies outside its star: (−1.2, 0) is beyond
+        // the thin triangles on the left, so the unguarded sweep would turn them over.
+        let v = vec![
+            [0.0, 0.0],
+            [1.0, -1.0],
+            [1.0, 1.0],
+            [-0.1, 1.0],
+            [-0.1, 0.05],
+            [-5.0, 0.0],
+            [-0.1, -0.05],
+            [-0.1, -1.0],
+        ];
+        let fan: Vec<u32> = (1..8).flat_map(|i| [0, i, i % 7 + 1]).collect();
+        let m = Mesh2::new_reoriented(v, fan).unwrap();
+        let s = smooth_laplacian(&m).unwrap();
+        assert!(s.volumes().iter().all(|&a| a > 0.0));
+        assert_eq!(s.vertices(), m.vertices());
     }
 
     proptest! {

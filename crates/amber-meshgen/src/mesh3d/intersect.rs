@@ -33,13 +33,45 @@ fn segment_meets_triangle(p: [f64; 3], q: [f64; 3], t: &Triangle) -> bool {
     }
 }
 
-/// The coplanar case, in the coordinate plane where the triangle's projection is largest.
-fn coplanar_segment_meets_triangle(p: [f64; 3], q: [f64; 3], t: &Triangle) -> bool {
+/// Whether two triangles of a surface (corner indices and positions) meet anywhere besides
+/// their shared corners and edge: disjoint triangles must not meet at all; triangles sharing a
+/// corner v meet elsewhere iff the edge opposite v in one meets the other (the common part
+/// is a segment from v); triangles sharing an edge overlap iff they fold flat onto one side.
+pub(crate) fn triangles_overlap(t: [u32; 3], tc: &Triangle, u: [u32; 3], uc: &Triangle) -> bool {
+    let shared: Vec<usize> = (0..3).filter(|&k| u.contains(&t[k])).collect();
+    let opposite = |x: [u32; 3], xc: &Triangle, k: usize| {
+        let j = (0..3).find(|&j| x[j] == t[k]).unwrap_or(0);
+        (xc[(j + 1) % 3], xc[(j + 2) % 3])
+    };
+    match shared[..] {
+        [] => triangles_intersect(tc, uc),
+        [k] => {
+            let ((a, b), (c, d)) = (opposite(t, tc, k), opposite(u, uc, k));
+            segment_meets_triangle(a, b, uc) || segment_meets_triangle(c, d, tc)
+        }
+        [k, l] => {
+            let apex = |x: [u32; 3], xc: &Triangle| xc[(0..3).find(|&j| x[j] != t[k] && x[j] != t[l]).unwrap_or(0)];
+            let (a, b) = (apex(t, tc), apex(u, uc));
+            let [p2, q2, a2, b2] = flatten(tc, [tc[k], tc[l], a, b]);
+            orient3d(tc[k], tc[l], a, b) == Equal && orient2d(p2, q2, a2) == orient2d(p2, q2, b2)
+        }
+        _ => true,
+    }
+}
+
+/// Drops the coordinate along which the triangle's normal is largest (a projection that keeps
+/// the triangle non-degenerate).
+fn flatten<const N: usize>(t: &Triangle, points: [[f64; 3]; N]) -> [[f64; 2]; N] {
     let n = normal(t);
     let drop = (0..3).max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs())).unwrap_or(2);
     let (i, j) = ((drop + 1) % 3, (drop + 2) % 3);
-    let flat = |x: [f64; 3]| [x[i], x[j]];
-    let (p, q, t) = (flat(p), flat(q), t.map(flat));
+    points.map(|x| [x[i], x[j]])
+}
+
+/// The coplanar case, in the coordinate plane where the triangle's projection is largest.
+fn coplanar_segment_meets_triangle(p: [f64; 3], q: [f64; 3], t: &Triangle) -> bool {
+    let [p, q, t0, t1, t2] = flatten(t, [p, q, t[0], t[1], t[2]]);
+    let t = [t0, t1, t2];
     point_in_triangle_2d(p, &t)
         || point_in_triangle_2d(q, &t)
         || (0..3).any(|k| segments_meet_2d(p, q, t[k], t[(k + 1) % 3]))
@@ -71,30 +103,59 @@ fn normal(t: &Triangle) -> [f64; 3] {
     [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
 }
 
-/// The first pair (by the lower index, then the higher) of triangles that intersect without
-/// sharing a vertex. Triangles that share a vertex are not tested: in a closed manifold surface
-/// they meet at that vertex or edge by construction.
-pub(crate) fn first_intersecting_pair(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Option<(usize, usize)> {
+/// The axis-aligned bounding box of a triangle.
+pub(crate) fn triangle_box(c: &Triangle) -> AABB<[f64; 3]> {
+    let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
+    let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
+    AABB::from_corners(lo, hi)
+}
+
+/// An R-tree of triangle bounding boxes, each tagged with the triangle's index. Entries are
+/// only added: callers re-insert a triangle whose corners changed and check candidates against
+/// its current corners, so stale boxes cost a little time and never hide a triangle.
+pub(crate) struct TriangleIndex(RTree<GeomWithData<Rectangle<[f64; 3]>, u32>>);
+
+impl TriangleIndex {
+    pub(crate) fn new(boxes: impl Iterator<Item = (u32, AABB<[f64; 3]>)>) -> Self {
+        Self(RTree::bulk_load(
+            boxes.map(|(t, b)| GeomWithData::new(Rectangle::from_corners(b.lower(), b.upper()), t)).collect(),
+        ))
+    }
+
+    pub(crate) fn insert(&mut self, t: u32, b: AABB<[f64; 3]>) {
+        self.0.insert(GeomWithData::new(Rectangle::from_corners(b.lower(), b.upper()), t));
+    }
+
+    /// Indices whose (possibly stale) box meets `b`, each once.
+    pub(crate) fn candidates(&self, b: AABB<[f64; 3]>) -> Vec<u32> {
+        let mut c: Vec<u32> = self.0.locate_in_envelope_intersecting(b).map(|e| e.data).collect();
+        c.sort_unstable();
+        c.dedup();
+        c
+    }
+}
+
+/// Every pair (t, u), t < u, sorted, of triangles without a common corner that intersect.
+/// Pairs with a common corner are left out: on planar and gently curved regions their exact
+/// test is mostly a (costly) proof of coplanarity, and folds between neighbours are what the
+/// callers' own orientation checks exclude.
+pub(crate) fn intersecting_pairs(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<(usize, usize)> {
     let corners = |t: usize| triangles[t].map(|v| vertices[v as usize]);
-    let boxes: Vec<AABB<[f64; 3]>> = (0..triangles.len())
-        .map(|t| {
-            let c = corners(t);
-            let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
-            let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
-            AABB::from_corners(lo, hi)
+    let index = TriangleIndex::new((0..triangles.len()).map(|t| (t as u32, triangle_box(&corners(t)))));
+    (0..triangles.len())
+        .into_par_iter()
+        .flat_map_iter(|t| {
+            let tri = corners(t);
+            index
+                .candidates(triangle_box(&tri))
+                .into_iter()
+                .map(|u| u as usize)
+                .filter(move |&u| u > t && !triangles[u].iter().any(|v| triangles[t].contains(v)))
+                .filter(move |&u| triangles_intersect(&tri, &corners(u)))
+                .map(move |u| (t, u))
+                .collect::<Vec<_>>()
         })
-        .collect();
-    let tree = RTree::bulk_load(
-        boxes.iter().enumerate().map(|(t, b)| GeomWithData::new(Rectangle::from_corners(b.lower(), b.upper()), t)).collect(),
-    );
-    boxes.par_iter().enumerate().find_map_first(|(t, b)| {
-        tree.locate_in_envelope_intersecting(*b)
-            .map(|other| other.data)
-            .filter(|&u| u > t && !triangles[u].iter().any(|v| triangles[t].contains(v)))
-            .filter(|&u| triangles_intersect(&corners(t), &corners(u)))
-            .min()
-            .map(|u| (t, u))
-    })
+        .collect()
 }
 
 #[cfg(test)]
@@ -131,10 +192,41 @@ mod tests {
     }
 
     #[test]
-    fn pairs_sharing_a_vertex_are_skipped_and_others_found() {
-        let vertices = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.2, 0.2, -1.0], [0.2, 0.2, 1.0], [0.3, 0.9, 0.5]];
+    fn neighbours_overlap_only_when_folded_or_pierced() {
+        let v = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.3, 0.3, 0.0],
+            [0.5, 0.5, 1.0],
+            [-1.0, 0.5, 1.0],
+        ];
+        let c = |t: [u32; 3]| t.map(|i| v[i as usize]);
+        let pair = |t: [u32; 3], u: [u32; 3]| triangles_overlap(t, &c(t), u, &c(u));
+        // Shared edge 1–2: unfolded (apexes 0 and 3 on opposite sides) or folded onto one side.
+        assert!(!pair([0, 1, 2], [1, 3, 2]));
+        assert!(pair([0, 1, 2], [1, 2, 4]));
+        // Shared corner 0: the other triangle rises out of the plane (touching at 0 only), cuts
+        // through along its edge 0–3, or lies inside.
+        assert!(!pair([0, 1, 2], [0, 5, 6]));
+        assert!(pair([0, 1, 2], [0, 5, 3]));
+        assert!(pair([0, 1, 2], [0, 4, 3]));
+    }
+
+    #[test]
+    fn intersecting_pairs_are_found() {
+        let vertices = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.2, 0.2, -1.0],
+            [0.2, 0.2, 1.0],
+            [0.3, 0.9, 0.5],
+        ];
         let triangles = vec![[0, 1, 2], [1, 3, 2], [4, 5, 6]];
-        assert_eq!(first_intersecting_pair(&vertices, &triangles[..2]), None);
-        assert_eq!(first_intersecting_pair(&vertices, &triangles), Some((0, 2)));
+        assert_eq!(intersecting_pairs(&vertices, &triangles[..2]), []);
+        assert_eq!(intersecting_pairs(&vertices, &triangles), [(0, 2)]);
     }
 }

@@ -22,7 +22,8 @@ pub(crate) fn orient3d(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> Or
     let (ca, ac) = (cdy * adz, cdz * ady);
     let (ab, ba) = (ady * bdz, adz * bdy);
     let det = adx * (bc - cb) + bdx * (ca - ac) + cdx * (ab - ba);
-    let permanent = (bc.abs() + cb.abs()) * adx.abs() + (ca.abs() + ac.abs()) * bdx.abs() + (ab.abs() + ba.abs()) * cdx.abs();
+    let permanent =
+        (bc.abs() + cb.abs()) * adx.abs() + (ca.abs() + ac.abs()) * bdx.abs() + (ab.abs() + ba.abs()) * cdx.abs();
     let shewchuk = if det.abs() > ORIENT3D_BOUND * permanent {
         det.partial_cmp(&0.0).unwrap_or(Ordering::Equal)
     } else {
@@ -30,8 +31,10 @@ pub(crate) fn orient3d(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> Or
             let p = [a, b, c][i];
             two_diff(p[k], d[k])
         };
-        let minor = |i: usize, j: usize, k0: usize, k1: usize| sub(&mul(&m(i, k0), &m(j, k1)), &mul(&m(i, k1), &m(j, k0)));
-        let terms = [mul(&m(0, 0), &minor(1, 2, 1, 2)), mul(&m(1, 0), &minor(2, 0, 1, 2)), mul(&m(2, 0), &minor(0, 1, 1, 2))];
+        let minor =
+            |i: usize, j: usize, k0: usize, k1: usize| sub(&mul(&m(i, k0), &m(j, k1)), &mul(&m(i, k1), &m(j, k0)));
+        let terms =
+            [mul(&m(0, 0), &minor(1, 2, 1, 2)), mul(&m(1, 0), &minor(2, 0, 1, 2)), mul(&m(2, 0), &minor(0, 1, 1, 2))];
         sign(&add(&add(&terms[0], &terms[1]), &terms[2]))
     };
     shewchuk.reverse()
@@ -49,8 +52,40 @@ pub(crate) fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> Ordering {
     sign(&sub(&mul(&d(a, 0), &d(b, 1)), &mul(&d(a, 1), &d(b, 0))))
 }
 
-/// An exact value as a sum of non-overlapping doubles of increasing magnitude.
-type Expansion = Vec<f64>;
+/// An exact value as a sum of non-overlapping doubles of increasing magnitude, on the stack.
+/// 192 terms is the most `orient3d` needs: a 3×3 determinant of 2-term differences.
+#[derive(Clone, Copy)]
+struct Expansion {
+    len: usize,
+    terms: [f64; 192],
+}
+
+impl Expansion {
+    const ZERO: Self = Self { len: 0, terms: [0.0; 192] };
+
+    fn terms(&self) -> &[f64] {
+        &self.terms[..self.len]
+    }
+
+    /// Adds one double in place (Shewchuk's Grow-Expansion), dropping zero components.
+    fn grow(&mut self, b: f64) {
+        let mut q = b;
+        let mut k = 0;
+        for i in 0..self.len {
+            let (s, h) = two_sum(q, self.terms[i]);
+            if h != 0.0 {
+                self.terms[k] = h;
+                k += 1;
+            }
+            q = s;
+        }
+        if q != 0.0 {
+            self.terms[k] = q;
+            k += 1;
+        }
+        self.len = k;
+    }
+}
 
 fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let x = a + b;
@@ -59,48 +94,34 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (x, (a - av) + (b - bv))
 }
 
+/// a − b exactly.
 fn two_diff(a: f64, b: f64) -> Expansion {
-    let (x, y) = two_sum(a, -b);
-    vec![y, x]
-}
-
-/// Adds one double to an expansion (Shewchuk's Grow-Expansion), dropping zero components.
-fn grow(e: &mut Expansion, b: f64) {
-    let mut q = b;
-    let mut out = Vec::with_capacity(e.len() + 1);
-    for &x in e.iter() {
-        let (s, h) = two_sum(q, x);
-        if h != 0.0 {
-            out.push(h);
-        }
-        q = s;
-    }
-    if q != 0.0 {
-        out.push(q);
-    }
-    *e = out;
+    let mut e = Expansion::ZERO;
+    e.grow(a);
+    e.grow(-b);
+    e
 }
 
 fn add(e: &Expansion, f: &Expansion) -> Expansion {
-    let mut out = e.clone();
-    f.iter().for_each(|&x| grow(&mut out, x));
+    let mut out = *e;
+    f.terms().iter().for_each(|&x| out.grow(x));
     out
 }
 
 fn sub(e: &Expansion, f: &Expansion) -> Expansion {
-    let mut out = e.clone();
-    f.iter().for_each(|&x| grow(&mut out, -x));
+    let mut out = *e;
+    f.terms().iter().for_each(|&x| out.grow(-x));
     out
 }
 
 fn mul(e: &Expansion, f: &Expansion) -> Expansion {
-    let mut out = Vec::new();
-    for &x in e {
-        for &y in f {
+    let mut out = Expansion::ZERO;
+    for &x in e.terms() {
+        for &y in f.terms() {
             let p = x * y;
             // The fused multiply-add rounds once, so it returns the exact rounding error of p.
-            grow(&mut out, x.mul_add(y, -p));
-            grow(&mut out, p);
+            out.grow(x.mul_add(y, -p));
+            out.grow(p);
         }
     }
     out
@@ -108,7 +129,7 @@ fn mul(e: &Expansion, f: &Expansion) -> Expansion {
 
 /// The largest component decides the sign of a non-overlapping expansion.
 fn sign(e: &Expansion) -> Ordering {
-    e.last().map_or(Ordering::Equal, |x| x.partial_cmp(&0.0).unwrap_or(Ordering::Equal))
+    e.terms().last().map_or(Ordering::Equal, |x| x.partial_cmp(&0.0).unwrap_or(Ordering::Equal))
 }
 
 #[cfg(test)]
@@ -129,7 +150,8 @@ mod tests {
     fn det3_i128(a: [i64; 3], b: [i64; 3], c: [i64; 3], d: [i64; 3]) -> Ordering {
         let r = |p: [i64; 3]| [0, 1, 2].map(|k| (p[k] - a[k]) as i128);
         let (u, v, w) = (r(b), r(c), r(d));
-        let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+        let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+            + u[2] * (v[0] * w[1] - v[1] * w[0]);
         det.cmp(&0)
     }
 
@@ -161,7 +183,8 @@ mod tests {
             // c on the line through a and b = a + dir, nudged by at most one unit.
             let b = [a[0] + dir[0], a[1] + dir[1]];
             let c = [a[0] + t * dir[0] + nudge[0], a[1] + t * dir[1] + nudge[1]];
-            let exact = ((b[0] - a[0]) as i128 * (c[1] - a[1]) as i128 - (b[1] - a[1]) as i128 * (c[0] - a[0]) as i128).cmp(&0);
+            let d = |p: [i64; 2], k: usize| (p[k] - a[k]) as i128;
+            let exact = (d(b, 0) * d(c, 1) - d(b, 1) * d(c, 0)).cmp(&0);
             let g = |p: [i64; 2]| p.map(|x| x as f64);
             proptest::prop_assert_eq!(orient2d(g(a), g(b), g(c)), exact);
         }

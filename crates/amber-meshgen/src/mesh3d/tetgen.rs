@@ -87,9 +87,8 @@ impl TetgenSwitches {
             s.push('Y');
         }
         if let Some(q) = self.quality {
-            if !(q.max_radius_edge_ratio.is_finite() && q.max_radius_edge_ratio > 0.0)
-                || !(0.0..90.0).contains(&q.min_dihedral_deg)
-            {
+            let ratio_ok = q.max_radius_edge_ratio.is_finite() && q.max_radius_edge_ratio > 0.0;
+            if !ratio_ok || !(0.0..90.0).contains(&q.min_dihedral_deg) {
                 return Err(TetgenError::InvalidSwitches(format!("{q:?}")));
             }
             s += &format!("q{}/{}", q.max_radius_edge_ratio, q.min_dihedral_deg);
@@ -162,6 +161,12 @@ pub enum TetgenError {
     /// More entries than TetGen's `int` indices can address.
     #[error("{what}: {count} entries exceed TetGen's limit")]
     TooLarge { what: &'static str, count: usize },
+    /// TetGen removed every tet as exterior: the surface encloses nothing (it is not closed).
+    #[error("TetGen's mesh has no tets: the surface does not enclose a volume (is it closed?)")]
+    NoTets,
+    /// TetGen dropped or reordered input points (duplicates, or points no triangle uses).
+    #[error("TetGen dropped input points (duplicates or unused): {input} in, {output} out, or reordered them")]
+    DroppedPoints { input: usize, output: usize },
     /// A switch value out of range.
     #[error("invalid TetGen switch values: {0}")]
     InvalidSwitches(String),
@@ -211,6 +216,10 @@ pub fn tetrahedralize(
         point_sizes,
         (bg_points, &bg_tets, background.map(|(_, s)| s)),
     )?;
+    if out.tets.is_empty() {
+        return Err(TetgenError::NoTets);
+    }
+    keeps_input_points(&plc.points, &out.points)?;
     let mesh = Mesh3::new(out.points, out.tets)?;
     let mut boundary = out.faces;
     orient_outward(&mesh, &mut boundary);
@@ -218,12 +227,35 @@ pub fn tetrahedralize(
     Ok(TetgenMesh { mesh, boundary, boundary_markers })
 }
 
-/// Delaunay tetrahedralisation of the convex hull of `points` (no `p` switch), e.g. the
-/// convex background mesh of spec §2 (3D).
+/// Delaunay tetrahedralisation of the convex hull of `points` (no `p` switch); the mesh's
+/// vertices are `points` in their order (duplicate points are an error).
 pub fn delaunay(points: &[[f64; 3]]) -> Result<Mesh3, TetgenError> {
     check_points(points)?;
     let out = run("Q", points, (&[], &[]), None, (&[], &[], None))?;
+    keeps_input_points(points, &out.points)?;
     Ok(Mesh3::new(out.points, out.tets)?)
+}
+
+/// The convex background mesh for `-m` (spec §2, 3D): the Delaunay tetrahedralisation of the
+/// nodes of `mesh` plus the 8 corners of their bounding box grown by `padding` on every side,
+/// with `nodal_sizes` at the nodes and the size of the nearest node at each corner.
+///
+/// TetGen locates every point it creates in the background mesh; with the (non-convex) current
+/// mesh itself, points just outside its curved boundary would get no size.
+pub fn convex_background(mesh: &Mesh3, nodal_sizes: &[f64], padding: f64) -> Result<(Mesh3, Vec<f64>), TetgenError> {
+    check_len("nodal_sizes", mesh.num_vertices(), nodal_sizes.len())?;
+    check_sizes("node", nodal_sizes)?;
+    let Some((lo, hi)) = mesh.bounding_box() else { return Err(TetgenError::FlatInput) };
+    let mut points = mesh.vertices().to_vec();
+    let mut sizes = nodal_sizes.to_vec();
+    for c in 0..8 {
+        let corner = [0, 1, 2].map(|k| if c >> k & 1 == 0 { lo[k] - padding } else { hi[k] + padding });
+        let distance = |p: &[f64; 3]| (0..3).map(|k| (p[k] - corner[k]).powi(2)).sum::<f64>();
+        let nearest = (0..mesh.num_vertices()).min_by(|&a, &b| distance(&points[a]).total_cmp(&distance(&points[b])));
+        points.push(corner);
+        sizes.push(nearest.map_or(f64::NAN, |v| nodal_sizes[v]));
+    }
+    Ok((delaunay(&points)?, sizes))
 }
 
 struct RawOutput {
@@ -278,7 +310,10 @@ fn run(
         let nt = sys::amber_tetgen_num_tets(result) as usize;
         let nf = sys::amber_tetgen_num_faces(result) as usize;
         let out = RawOutput {
-            points: slice(sys::amber_tetgen_points(result), 3 * np).chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect(),
+            points: slice(sys::amber_tetgen_points(result), 3 * np)
+                .chunks_exact(3)
+                .map(|p| [p[0], p[1], p[2]])
+                .collect(),
             tets: slice(sys::amber_tetgen_tets(result), 4 * nt).iter().map(|&v| v as u32).collect(),
             faces: slice(sys::amber_tetgen_faces(result), 3 * nf)
                 .chunks_exact(3)
@@ -318,6 +353,16 @@ fn to_int(count: usize, what: &'static str) -> Result<c_int, TetgenError> {
     c_int::try_from(count).ok().filter(|&c| c <= c_int::MAX / 4).ok_or(TetgenError::TooLarge { what, count })
 }
 
+/// TetGen drops duplicate and unused input points and renumbers the rest; the callers rely on
+/// the input points coming first, unchanged and in order.
+fn keeps_input_points(input: &[[f64; 3]], output: &[[f64; 3]]) -> Result<(), TetgenError> {
+    if output.get(..input.len()) == Some(input) {
+        Ok(())
+    } else {
+        Err(TetgenError::DroppedPoints { input: input.len(), output: output.len() })
+    }
+}
+
 fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), TetgenError> {
     if expected == found { Ok(()) } else { Err(TetgenError::LengthMismatch { what, expected, found }) }
 }
@@ -343,7 +388,8 @@ fn orient_outward(mesh: &Mesh3, faces: &mut [[u32; 3]]) {
         f.sort_unstable();
         f
     };
-    let mut behind: HashMap<[u32; 3], (u32, usize)> = faces.iter().enumerate().map(|(i, &f)| (key(f), (0, i))).collect();
+    let mut behind: HashMap<[u32; 3], (u32, usize)> =
+        faces.iter().enumerate().map(|(i, &f)| (key(f), (0, i))).collect();
     let mut opposite = vec![u32::MAX; faces.len()];
     for tet in mesh.elements() {
         for skip in 0..4 {
@@ -424,7 +470,8 @@ mod tests {
         assert_eq!(s.to_command(true).unwrap(), "pYq1.4/20mO7/7o/150Q");
         assert_eq!(s.to_command(false).unwrap(), "pYq1.4/20O7/7o/150Q");
         assert_eq!(TetgenSwitches::plain_quality(1.4).to_command(false).unwrap(), "pq1.4/0Q");
-        let bad = TetgenSwitches { optimization: Some(Optimization { level: 12, scheme: 7, max_dihedral_deg: 150.0 }), ..s };
+        let bad =
+            TetgenSwitches { optimization: Some(Optimization { level: 12, scheme: 7, max_dihedral_deg: 150.0 }), ..s };
         assert!(matches!(bad.to_command(true), Err(TetgenError::InvalidSwitches(_))));
     }
 
@@ -487,6 +534,13 @@ mod tests {
         ));
         let flat: Vec<[f64; 3]> = (0..6).map(|i| [i as f64, (i * i) as f64, 0.0]).collect();
         assert!(matches!(delaunay(&flat), Err(TetgenError::FlatInput)));
+        let mut open = cube(1);
+        open.triangles.pop();
+        open.face_markers.pop();
+        assert!(matches!(tetrahedralize(&open, None, None, &TetgenSwitches::default()), Err(TetgenError::NoTets)));
+        let mut twice = cube(1).points;
+        twice.push(twice[3]);
+        assert!(matches!(delaunay(&twice), Err(TetgenError::DroppedPoints { input: 9, output: 8 })));
     }
 
     #[test]
@@ -498,24 +552,31 @@ mod tests {
         let switches = TetgenSwitches { keep_boundary: false, ..TetgenSwitches::default() };
         let out = tetrahedralize(&plc, Some(&sizes), None, &switches).unwrap();
         let median = |v: Vec<f64>| v[v.len() / 2];
-        let (fine, coarse) = (median(edge_lengths_near(&out.mesh, 0.0..0.2)), median(edge_lengths_near(&out.mesh, 0.8..1.0)));
+        let (fine, coarse) =
+            (median(edge_lengths_near(&out.mesh, 0.0..0.2)), median(edge_lengths_near(&out.mesh, 0.8..1.0)));
         assert!(fine < 0.5 * coarse, "median edge near x=0: {fine}, near x=1: {coarse}");
         assert!((out.mesh.total_volume() - 1.0).abs() < 1e-12);
     }
 
     #[test]
     fn background_mesh_drives_the_sizes() {
-        // Convex background = Delaunay of a 5×5×5 grid, size 0.04 + 0.3·x: a graded interior
-        // inside the 12-triangle cube with no point sizes at all.
+        // Background = a 5×5×5 grid, size 0.04 + 0.3·x, made convex with padded corners: a
+        // graded interior inside the 12-triangle cube with no point sizes at all.
         let grid: Vec<[f64; 3]> =
             (0..125).map(|i| [(i % 5) as f64 / 4.0, ((i / 5) % 5) as f64 / 4.0, (i / 25) as f64 / 4.0]).collect();
-        let bg = delaunay(&grid).unwrap();
-        assert!((bg.total_volume() - 1.0).abs() < 1e-12);
-        let sizes: Vec<f64> = bg.vertices().iter().map(|p| 0.04 + 0.3 * p[0]).collect();
+        let grid_mesh = delaunay(&grid).unwrap();
+        assert!((grid_mesh.total_volume() - 1.0).abs() < 1e-12);
+        let grid_sizes: Vec<f64> = grid.iter().map(|p| 0.04 + 0.3 * p[0]).collect();
+        let (bg, sizes) = convex_background(&grid_mesh, &grid_sizes, 0.1).unwrap();
+        assert!((bg.total_volume() - 1.2f64.powi(3)).abs() < 1e-12);
+        assert_eq!(&sizes[..125], &grid_sizes[..]);
+        let (lo, hi) = (grid_sizes[0], grid_sizes[4]);
+        assert_eq!(&sizes[125..], &[lo, hi, lo, hi, lo, hi, lo, hi]);
         let switches = TetgenSwitches { keep_boundary: false, ..TetgenSwitches::default() };
         let out = tetrahedralize(&cube(1), None, Some((&bg, &sizes)), &switches).unwrap();
         let median = |v: Vec<f64>| v[v.len() / 2];
-        let (fine, coarse) = (median(edge_lengths_near(&out.mesh, 0.0..0.2)), median(edge_lengths_near(&out.mesh, 0.8..1.0)));
+        let (fine, coarse) =
+            (median(edge_lengths_near(&out.mesh, 0.0..0.2)), median(edge_lengths_near(&out.mesh, 0.8..1.0)));
         assert!(fine < 0.5 * coarse, "median edge near x=0: {fine}, near x=1: {coarse}");
     }
 }

@@ -1,0 +1,779 @@
+//! Adaptive isotropic surface remeshing (Botsch & Kobbelt 2004) of a CAD-face-labelled
+//! reference surface toward a sizing field, so that TetGen — which never coarsens its input
+//! surface — gets a boundary that already has the target sizes (spec §2, 3D).
+//!
+//! Every iteration splits edges longer than 4/3·h, collapses edges shorter than 4/5·h, flips
+//! edges toward valence 6, smooths tangentially and projects back onto the reference. CAD
+//! faces are never merged: every vertex stays on its own face (projection onto that face
+//! only, which keeps the two sides of a thin sheet apart), vertices on the curve between two
+//! faces stay on that curve, and corners (vertices of three or more faces) never move.
+//! No operation may make the surface intersect itself: collapses and flips whose new triangles
+//! would cross another are refused, and vertices whose move (split or smoothing) made
+//! triangles cross go back to where they were safe.
+
+use std::collections::HashMap;
+
+use rstar::primitives::Line;
+use rstar::{AABB, PointDistance, RTree, RTreeObject};
+
+use super::intersect::{TriangleIndex, intersecting_pairs, triangle_box, triangles_overlap};
+use super::surface::{Surface, SurfaceDefect};
+use crate::SizingField;
+
+/// Remeshing settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RemeshParams {
+    /// Split–collapse–flip–smooth–project rounds (the literature uses 5–10).
+    pub iterations: usize,
+    /// How far, as a fraction of the local size, the midpoint of an edge that a collapse or
+    /// flip creates may lie from its CAD face or curve. Keeps curved faces resolved and stops
+    /// edges from cutting across holes and concave corners.
+    pub max_relative_deviation: f64,
+    /// Stop with an error rather than grow beyond this many triangles (sizes far too small).
+    pub max_triangles: usize,
+}
+
+impl Default for RemeshParams {
+    fn default() -> Self {
+        Self { iterations: 6, max_relative_deviation: 0.1, max_triangles: 2_000_000 }
+    }
+}
+
+/// Remeshing failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RemeshError {
+    /// The sizing field returned a size that is not positive and finite.
+    #[error("the sizing field returned {value} at {at:?}; sizes must be positive and finite")]
+    InvalidSize { at: [f64; 3], value: f64 },
+    /// The sizes are so small that the surface would exceed the triangle cap.
+    #[error("the surface would exceed {cap} triangles (sizes too small?)")]
+    TooManyTriangles { cap: usize },
+    /// The remeshed surface failed validation: a self-intersection that moving vertices back
+    /// could not undo, or a bug; reported rather than handed to TetGen.
+    #[error("the remeshed surface is invalid: {0}")]
+    InvalidResult(#[from] SurfaceDefect),
+}
+
+/// Remeshes a validated (closed, outward) `reference` surface so that its edges follow `sizing`,
+/// keeping every CAD face, curve and corner. The result is validated.
+pub fn remesh<S: SizingField<3>>(
+    reference: &Surface,
+    sizing: &S,
+    params: &RemeshParams,
+) -> Result<Surface, RemeshError> {
+    let context = Context { sizing, projector: Projector::new(reference), params: *params };
+    let mut mesh = WorkMesh::new(reference);
+    for _ in 0..params.iterations {
+        mesh.split_long_edges(&context)?;
+        mesh.collapse_short_edges(&context)?;
+        mesh.flip_toward_valence_six(&context)?;
+        mesh.smooth_and_project(&context.projector);
+    }
+    let mut surface = mesh.into_surface()?;
+    surface.validate()?;
+    Ok(surface)
+}
+
+/// What the mesh operations measure against: the sizing field and the reference surface.
+struct Context<'a, S> {
+    sizing: &'a S,
+    projector: Projector,
+    params: RemeshParams,
+}
+
+impl<S: SizingField<3>> Context<'_, S> {
+    fn size(&self, p: [f64; 3]) -> Result<f64, RemeshError> {
+        let value = self.sizing.size_at(p);
+        if value.is_finite() && value > 0.0 { Ok(value) } else { Err(RemeshError::InvalidSize { at: p, value }) }
+    }
+
+    /// Whether an edge p–q on `kind` (a face, or the curve of a feature edge) stays close
+    /// enough to the reference at its midpoint.
+    fn follows_reference(&self, p: [f64; 3], q: [f64; 3], kind: Kind) -> Result<bool, RemeshError> {
+        let mid = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
+        let deviation = norm(sub(self.projector.project(mid, kind), mid));
+        Ok(deviation <= self.params.max_relative_deviation * self.size(mid)?)
+    }
+}
+
+/// Where a vertex may move: on one CAD face, on the curve between two faces, or nowhere.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Face(i32),
+    Curve(i32, i32),
+    Corner,
+}
+
+/// The kind implied by the CAD faces around a vertex.
+fn kind_of(faces: &mut Vec<i32>) -> Kind {
+    faces.sort_unstable();
+    faces.dedup();
+    match faces[..] {
+        [f] => Kind::Face(f),
+        [f, g] => Kind::Curve(f, g),
+        _ => Kind::Corner,
+    }
+}
+
+/// Closest points on the reference surface, restricted to one CAD face or one curve.
+struct Projector {
+    faces: HashMap<i32, RTree<RefTriangle>>,
+    curves: HashMap<(i32, i32), RTree<Line<[f64; 3]>>>,
+}
+
+impl Projector {
+    fn new(reference: &Surface) -> Self {
+        let (v, t, ids) = (reference.vertices(), reference.triangles(), reference.face_ids());
+        let mut faces: HashMap<i32, Vec<RefTriangle>> = HashMap::new();
+        let mut edge_faces: HashMap<[u32; 2], Vec<i32>> = HashMap::new();
+        for (tri, &id) in t.iter().zip(ids) {
+            faces.entry(id).or_default().push(RefTriangle(tri.map(|i| v[i as usize])));
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                edge_faces.entry([a.min(b), a.max(b)]).or_default().push(id);
+            }
+        }
+        let mut curves: HashMap<(i32, i32), Vec<Line<[f64; 3]>>> = HashMap::new();
+        for ([a, b], ids) in edge_faces {
+            if let [f, g] = ids[..]
+                && f != g
+            {
+                curves.entry((f.min(g), f.max(g))).or_default().push(Line::new(v[a as usize], v[b as usize]));
+            }
+        }
+        Self {
+            faces: faces.into_iter().map(|(id, tris)| (id, RTree::bulk_load(tris))).collect(),
+            curves: curves.into_iter().map(|(key, lines)| (key, RTree::bulk_load(lines))).collect(),
+        }
+    }
+
+    fn project(&self, p: [f64; 3], kind: Kind) -> [f64; 3] {
+        match kind {
+            Kind::Face(f) => self.faces.get(&f).and_then(|tree| tree.nearest_neighbor(p)).map_or(p, |t| t.closest(p)),
+            Kind::Curve(f, g) => {
+                self.curves.get(&(f, g)).and_then(|tree| tree.nearest_neighbor(p)).map_or(p, |l| l.nearest_point(&p))
+            }
+            Kind::Corner => p,
+        }
+    }
+}
+
+/// A reference triangle in an R-tree that answers distance queries exactly.
+struct RefTriangle([[f64; 3]; 3]);
+
+impl RefTriangle {
+    /// Closest point of the triangle to `p` (Ericson, Real-Time Collision Detection §5.1.5).
+    fn closest(&self, p: [f64; 3]) -> [f64; 3] {
+        let [a, b, c] = self.0;
+        let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+        let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+        if d1 <= 0.0 && d2 <= 0.0 {
+            return a;
+        }
+        let bp = sub(p, b);
+        let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+        if d3 >= 0.0 && d4 <= d3 {
+            return b;
+        }
+        let vc = d1 * d4 - d3 * d2;
+        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            return axpy(a, d1 / (d1 - d3), ab);
+        }
+        let cp = sub(p, c);
+        let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+        if d6 >= 0.0 && d5 <= d6 {
+            return c;
+        }
+        let vb = d5 * d2 - d1 * d6;
+        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            return axpy(a, d2 / (d2 - d6), ac);
+        }
+        let va = d3 * d6 - d5 * d4;
+        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            return axpy(b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), sub(c, b));
+        }
+        let denom = 1.0 / (va + vb + vc);
+        axpy(axpy(a, vb * denom, ab), vc * denom, ac)
+    }
+}
+
+impl RTreeObject for RefTriangle {
+    type Envelope = AABB<[f64; 3]>;
+
+    fn envelope(&self) -> Self::Envelope {
+        AABB::from_points(self.0.iter())
+    }
+}
+
+impl PointDistance for RefTriangle {
+    fn distance_2(&self, p: &[f64; 3]) -> f64 {
+        let q = self.closest(*p);
+        dot(sub(q, *p), sub(q, *p))
+    }
+}
+
+/// The surface being remeshed: triangles with their CAD faces and vertex → triangle lists.
+/// Removed triangles and vertices stay as tombstones until [`WorkMesh::into_surface`].
+struct WorkMesh {
+    pos: Vec<[f64; 3]>,
+    kind: Vec<Kind>,
+    vertex_alive: Vec<bool>,
+    triangles: Vec<[u32; 3]>,
+    face: Vec<i32>,
+    triangle_alive: Vec<bool>,
+    around: Vec<Vec<u32>>,
+}
+
+impl WorkMesh {
+    fn new(s: &Surface) -> Self {
+        let n = s.vertices().len();
+        let mut around: Vec<Vec<u32>> = vec![Vec::with_capacity(6); n];
+        for (t, tri) in s.triangles().iter().enumerate() {
+            tri.iter().for_each(|&v| around[v as usize].push(t as u32));
+        }
+        let kind =
+            around.iter().map(|ts| kind_of(&mut ts.iter().map(|&t| s.face_ids()[t as usize]).collect())).collect();
+        Self {
+            pos: s.vertices().to_vec(),
+            kind,
+            vertex_alive: vec![true; n],
+            triangles: s.triangles().to_vec(),
+            face: s.face_ids().to_vec(),
+            triangle_alive: vec![true; s.triangles().len()],
+            around,
+        }
+    }
+
+    fn num_triangles(&self) -> usize {
+        self.triangle_alive.iter().filter(|&&a| a).count()
+    }
+
+    /// Every edge once, as (smaller, larger) vertex index.
+    fn edges(&self) -> Vec<[u32; 2]> {
+        let mut edges: Vec<[u32; 2]> = (0..self.triangles.len())
+            .filter(|&t| self.triangle_alive[t])
+            .flat_map(|t| {
+                let tri = self.triangles[t];
+                (0..3).map(move |k| [tri[k].min(tri[(k + 1) % 3]), tri[k].max(tri[(k + 1) % 3])])
+            })
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
+
+    /// The two triangles of edge (a, b), or `None` if it is no longer an edge.
+    fn edge_triangles(&self, a: u32, b: u32) -> Option<[u32; 2]> {
+        let mut it = self.around[a as usize].iter().copied().filter(|&t| self.triangles[t as usize].contains(&b));
+        Some([it.next()?, it.next()?])
+    }
+
+    fn neighbours(&self, v: u32) -> Vec<u32> {
+        let mut n: Vec<u32> =
+            self.around[v as usize].iter().flat_map(|&t| self.triangles[t as usize]).filter(|&x| x != v).collect();
+        n.sort_unstable();
+        n.dedup();
+        n
+    }
+
+    /// The corner of triangle `t` opposite edge (a, b).
+    fn apex(&self, t: u32, a: u32, b: u32) -> u32 {
+        self.triangles[t as usize].into_iter().find(|&x| x != a && x != b).unwrap_or(a)
+    }
+
+    fn length(&self, a: u32, b: u32) -> f64 {
+        norm(sub(self.pos[a as usize], self.pos[b as usize]))
+    }
+
+    fn midpoint(&self, a: u32, b: u32) -> [f64; 3] {
+        let (p, q) = (self.pos[a as usize], self.pos[b as usize]);
+        [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]))
+    }
+
+    fn normal(&self, tri: [u32; 3]) -> [f64; 3] {
+        let [a, b, c] = tri.map(|v| self.pos[v as usize]);
+        cross(sub(b, a), sub(c, a))
+    }
+
+    /// Splits every edge longer than 4/3 of the size at its midpoint, repeating until none is
+    /// (or for at most 16 rounds, which halve edges 2^16-fold).
+    fn split_long_edges<S: SizingField<3>>(&mut self, context: &Context<S>) -> Result<(), RemeshError> {
+        // Where a new vertex is safe: on the straight edge, inside the old triangles.
+        let mut safe = self.pos.clone();
+        for _ in 0..16 {
+            let mut split = 0;
+            for [a, b] in self.edges() {
+                let mid = self.midpoint(a, b);
+                if self.length(a, b) > 4.0 / 3.0 * context.size(mid)? && self.split(a, b, &context.projector) {
+                    safe.push(mid);
+                    split += 1;
+                }
+            }
+            let cap = context.params.max_triangles;
+            if self.num_triangles() > cap {
+                return Err(RemeshError::TooManyTriangles { cap });
+            }
+            if split == 0 {
+                break;
+            }
+        }
+        self.untangle(&safe);
+        Ok(())
+    }
+
+    /// Inserts the midpoint of edge (a, b), projected onto the reference, and splits both
+    /// triangles of the edge in two. Refuses (returns false) when the projection moves the
+    /// midpoint by more than a quarter of the edge: such an edge does not follow its face and
+    /// splitting it would not shorten it.
+    fn split(&mut self, a: u32, b: u32, projector: &Projector) -> bool {
+        let Some([t1, t2]) = self.edge_triangles(a, b) else { return false };
+        let kind = self.edge_kind(t1, t2);
+        let mid = self.midpoint(a, b);
+        let projected = projector.project(mid, kind);
+        if norm(sub(projected, mid)) > 0.25 * self.length(a, b) {
+            return false;
+        }
+        let m = self.pos.len() as u32;
+        self.pos.push(projected);
+        self.kind.push(kind);
+        self.vertex_alive.push(true);
+        self.around.push(Vec::with_capacity(6));
+        for t in [t1, t2] {
+            let tri = self.triangles[t as usize];
+            let k = (0..3).find(|&k| [a, b].contains(&tri[k]) && [a, b].contains(&tri[(k + 1) % 3])).unwrap_or(0);
+            let (x, y, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let new = self.triangles.len() as u32;
+            self.triangles[t as usize] = [x, m, c];
+            self.triangles.push([m, y, c]);
+            self.face.push(self.face[t as usize]);
+            self.triangle_alive.push(true);
+            let at_y = &mut self.around[y as usize];
+            at_y.retain(|&s| s != t);
+            at_y.push(new);
+            self.around[c as usize].push(new);
+            self.around[m as usize].extend([t, new]);
+        }
+        true
+    }
+
+    /// A new vertex on edge t1 ∩ t2 lies on their CAD face, or on the curve between their faces.
+    fn edge_kind(&self, t1: u32, t2: u32) -> Kind {
+        let (f, g) = (self.face[t1 as usize], self.face[t2 as usize]);
+        if f == g { Kind::Face(f) } else { Kind::Curve(f.min(g), f.max(g)) }
+    }
+
+    /// Collapses edges shorter than 4/5 of the size, shortest first, where allowed.
+    fn collapse_short_edges<S: SizingField<3>>(&mut self, context: &Context<S>) -> Result<(), RemeshError> {
+        let mut short = Vec::new();
+        for [a, b] in self.edges() {
+            let length = self.length(a, b);
+            if length < 0.8 * context.size(self.midpoint(a, b))? {
+                short.push((length, a, b));
+            }
+        }
+        short.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut index = self.index();
+        for (_, a, b) in short {
+            if !(self.vertex_alive[a as usize] && self.vertex_alive[b as usize]) || self.edge_triangles(a, b).is_none()
+            {
+                continue;
+            }
+            for (from, to) in [(a, b), (b, a)] {
+                if self.collapse_allowed(from, to, context, &index)? {
+                    for t in self.collapse(from, to) {
+                        index.insert(t, self.triangle_box(t));
+                    }
+                    break;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether vertex `from` may be merged into `to`: CAD structure kept, topology stays a
+    /// closed manifold (link condition), no triangle turns over, no new edge is too long or
+    /// strays from the reference.
+    fn collapse_allowed<S: SizingField<3>>(
+        &self,
+        from: u32,
+        to: u32,
+        context: &Context<S>,
+        index: &TriangleIndex,
+    ) -> Result<bool, RemeshError> {
+        let Some([t1, t2]) = self.edge_triangles(from, to) else { return Ok(false) };
+        let structure_kept = match self.kind[from as usize] {
+            Kind::Corner => false,
+            Kind::Face(_) => true,
+            Kind::Curve(..) => {
+                self.face[t1 as usize] != self.face[t2 as usize]
+                    && (self.kind[to as usize] == self.kind[from as usize] || self.kind[to as usize] == Kind::Corner)
+            }
+        };
+        if !structure_kept {
+            return Ok(false);
+        }
+        let (n_from, n_to) = (self.neighbours(from), self.neighbours(to));
+        let common = n_from.iter().filter(|v| n_to.binary_search(v).is_ok()).count();
+        if common != 2 || n_from.len() <= 3 || n_to.len() <= 3 {
+            return Ok(false);
+        }
+        let target = self.pos[to as usize];
+        for &x in n_from.iter().filter(|&&x| x != to && n_to.binary_search(&x).is_err()) {
+            let p = self.pos[x as usize];
+            let Some([s, t]) = self.edge_triangles(from, x) else { return Ok(false) };
+            if norm(sub(p, target)) > 4.0 / 3.0 * context.size([0, 1, 2].map(|k| 0.5 * (p[k] + target[k])))?
+                || !context.follows_reference(target, p, self.edge_kind(s, t))?
+            {
+                return Ok(false);
+            }
+        }
+        for &t in &self.around[from as usize] {
+            let tri = self.triangles[t as usize];
+            if tri.contains(&to) {
+                continue;
+            }
+            let old = self.normal(tri);
+            let new = self.normal(tri.map(|v| if v == from { to } else { v }));
+            // The moved triangle must keep its side, not become a needle and not cross another.
+            let moved = tri.map(|v| if v == from { to } else { v });
+            if dot(old, new) <= 0.0
+                || norm(new) < 1e-3 * norm(old).max(f64::MIN_POSITIVE)
+                || self.crosses(index, moved, &self.around[from as usize])
+            {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
+    /// Merges `from` into `to`; returns the triangles that changed corners.
+    fn collapse(&mut self, from: u32, to: u32) -> Vec<u32> {
+        let mut moved = Vec::new();
+        for t in std::mem::take(&mut self.around[from as usize]) {
+            let tri = self.triangles[t as usize];
+            if tri.contains(&to) {
+                self.triangle_alive[t as usize] = false;
+                for v in tri.into_iter().filter(|&v| v != from) {
+                    self.around[v as usize].retain(|&s| s != t);
+                }
+            } else {
+                self.triangles[t as usize] = tri.map(|v| if v == from { to } else { v });
+                self.around[to as usize].push(t);
+                moved.push(t);
+            }
+        }
+        self.vertex_alive[from as usize] = false;
+        moved
+    }
+
+    /// Flips edges inside a CAD face when that brings the four vertices closer to valence 6.
+    fn flip_toward_valence_six<S: SizingField<3>>(&mut self, context: &Context<S>) -> Result<(), RemeshError> {
+        let mut index = self.index();
+        for [a, b] in self.edges() {
+            let Some([t1, t2]) = self.edge_triangles(a, b) else { continue };
+            if self.face[t1 as usize] != self.face[t2 as usize] {
+                continue;
+            }
+            let (c, d) = (self.apex(t1, a, b), self.apex(t2, a, b));
+            if c == d || self.neighbours(c).binary_search(&d).is_ok() {
+                continue;
+            }
+            let valence = |v: u32| self.around[v as usize].len() as i64;
+            let deviation =
+                |va: i64, vb: i64, vc: i64, vd: i64| [va, vb, vc, vd].iter().map(|v| (v - 6) * (v - 6)).sum::<i64>();
+            let (va, vb, vc, vd) = (valence(a), valence(b), valence(c), valence(d));
+            if va <= 3 || vb <= 3 || deviation(va - 1, vb - 1, vc + 1, vd + 1) >= deviation(va, vb, vc, vd) {
+                continue;
+            }
+            // Orient so that t1 = (x, y, c) runs x → y; then t2 runs y → x with apex d.
+            let tri = self.triangles[t1 as usize];
+            let k = (0..3).find(|&k| tri[(k + 2) % 3] == c).unwrap_or(0);
+            let (x, y) = (tri[k], tri[(k + 1) % 3]);
+            let (new1, new2) = ([x, d, c], [y, c, d]);
+            let old = add(self.normal(self.triangles[t1 as usize]), self.normal(self.triangles[t2 as usize]));
+            let (n1, n2) = (self.normal(new1), self.normal(new2));
+            if dot(n1, old) <= 0.0 || dot(n2, old) <= 0.0 || dot(n1, n2) <= 0.0 {
+                continue;
+            }
+            let kind = Kind::Face(self.face[t1 as usize]);
+            if !context.follows_reference(self.pos[c as usize], self.pos[d as usize], kind)?
+                || self.crosses(&index, new1, &[t1, t2])
+                || self.crosses(&index, new2, &[t1, t2])
+            {
+                continue;
+            }
+            self.triangles[t1 as usize] = new1;
+            self.triangles[t2 as usize] = new2;
+            self.around[y as usize].retain(|&s| s != t1);
+            self.around[x as usize].retain(|&s| s != t2);
+            self.around[d as usize].push(t1);
+            self.around[c as usize].push(t2);
+            index.insert(t1, self.triangle_box(t1));
+            index.insert(t2, self.triangle_box(t2));
+        }
+        Ok(())
+    }
+
+    /// One Jacobi pass of tangential smoothing (face vertices toward the centroid of their
+    /// neighbours within the tangent plane, curve vertices toward the mean of their two curve
+    /// neighbours), each result projected onto its own face or curve of the reference.
+    fn smooth_and_project(&mut self, projector: &Projector) {
+        let safe = self.pos.clone();
+        let moved: Vec<[f64; 3]> = (0..self.pos.len() as u32)
+            .map(|v| {
+                let p = self.pos[v as usize];
+                let kind = self.kind[v as usize];
+                if !self.vertex_alive[v as usize] || kind == Kind::Corner {
+                    return p;
+                }
+                let neighbours: Vec<u32> = self
+                    .neighbours(v)
+                    .into_iter()
+                    .filter(|&x| {
+                        matches!(kind, Kind::Face(_))
+                            || self
+                                .edge_triangles(v, x)
+                                .is_some_and(|[s, t]| self.face[s as usize] != self.face[t as usize])
+                    })
+                    .collect();
+                if neighbours.is_empty() {
+                    return p;
+                }
+                let centroid = neighbours
+                    .iter()
+                    .fold([0.0; 3], |acc, &x| add(acc, self.pos[x as usize]))
+                    .map(|c| c / neighbours.len() as f64);
+                let mut step = sub(centroid, p);
+                if let Kind::Face(_) = kind {
+                    let n = self.around[v as usize]
+                        .iter()
+                        .fold([0.0; 3], |acc, &t| add(acc, self.normal(self.triangles[t as usize])));
+                    let nn = dot(n, n);
+                    if nn > 0.0 {
+                        step = axpy(step, -dot(step, n) / nn, n);
+                    }
+                }
+                projector.project(add(p, step), kind)
+            })
+            .collect();
+        self.pos = moved;
+        self.untangle(&safe);
+    }
+
+    fn triangle_box(&self, t: u32) -> AABB<[f64; 3]> {
+        triangle_box(&self.triangles[t as usize].map(|v| self.pos[v as usize]))
+    }
+
+    /// An index of the live triangles' boxes.
+    fn index(&self) -> TriangleIndex {
+        TriangleIndex::new(
+            (0..self.triangles.len() as u32)
+                .filter(|&t| self.triangle_alive[t as usize])
+                .map(|t| (t, self.triangle_box(t))),
+        )
+    }
+
+    /// Whether a triangle with corners `tri` would cross a live triangle other than the
+    /// `replaced` ones.
+    fn crosses(&self, index: &TriangleIndex, tri: [u32; 3], replaced: &[u32]) -> bool {
+        let corners = tri.map(|v| self.pos[v as usize]);
+        index.candidates(triangle_box(&corners)).into_iter().any(|u| {
+            let other = self.triangles[u as usize];
+            self.triangle_alive[u as usize]
+                && !replaced.contains(&u)
+                && triangles_overlap(tri, &corners, other, &other.map(|v| self.pos[v as usize]))
+        })
+    }
+
+    /// Sends the vertices of crossing triangles back to their `safe` positions (where the
+    /// surface did not cross itself), for a few rounds since a move back can expose another.
+    fn untangle(&mut self, safe: &[[f64; 3]]) {
+        for _ in 0..4 {
+            let live: Vec<[u32; 3]> =
+                (0..self.triangles.len()).filter(|&t| self.triangle_alive[t]).map(|t| self.triangles[t]).collect();
+            let mut moved_back = false;
+            for (t, u) in intersecting_pairs(&self.pos, &live) {
+                for &v in live[t].iter().chain(&live[u]) {
+                    if self.pos[v as usize] != safe[v as usize] {
+                        self.pos[v as usize] = safe[v as usize];
+                        moved_back = true;
+                    }
+                }
+            }
+            if !moved_back {
+                return;
+            }
+        }
+    }
+
+    /// The live part as a [`Surface`], renumbered.
+    fn into_surface(self) -> Result<Surface, SurfaceDefect> {
+        let mut index = vec![u32::MAX; self.pos.len()];
+        let mut vertices = Vec::new();
+        for (v, &alive) in self.vertex_alive.iter().enumerate() {
+            if alive {
+                index[v] = vertices.len() as u32;
+                vertices.push(self.pos[v]);
+            }
+        }
+        let live = (0..self.triangles.len()).filter(|&t| self.triangle_alive[t]);
+        let triangles = live.clone().map(|t| self.triangles[t].map(|v| index[v as usize])).collect();
+        let face_ids = live.map(|t| self.face[t]).collect();
+        Surface::new(vertices, triangles, face_ids)
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// a + s·b.
+fn axpy(a: [f64; 3], s: f64, b: [f64; 3]) -> [f64; 3] {
+    [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ConstantSize, FnSize};
+
+    /// The unit cube as 12 triangles, one CAD face per side.
+    fn cube() -> Surface {
+        let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let mut triangles = Vec::new();
+        let mut ids = Vec::new();
+        for (side, q) in quads.iter().enumerate() {
+            triangles.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
+            ids.extend([side as i32 + 1; 2]);
+        }
+        let mut s = Surface::new(v, triangles, ids).unwrap();
+        s.validate().unwrap();
+        s
+    }
+
+    /// Median and 5th/95th percentile of edge length / size at the edge midpoint.
+    fn edge_ratios(s: &Surface, h: impl Fn([f64; 3]) -> f64) -> (f64, f64, f64) {
+        let v = s.vertices();
+        let mut r: Vec<f64> = s
+            .triangles()
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .map(|(a, b)| {
+                let (p, q) = (v[a as usize], v[b as usize]);
+                norm(sub(p, q)) / h([0, 1, 2].map(|k| 0.5 * (p[k] + q[k])))
+            })
+            .collect();
+        r.sort_by(f64::total_cmp);
+        (r[r.len() / 2], r[r.len() / 20], r[r.len() * 19 / 20])
+    }
+
+    #[test]
+    fn cube_is_refined_to_a_uniform_size_with_its_edges_and_corners_kept() {
+        let out = remesh(&cube(), &ConstantSize(0.1), &RemeshParams::default()).unwrap();
+        let (median, p5, p95) = edge_ratios(&out, |_| 0.1);
+        assert!((0.8..1.2).contains(&median) && p5 > 0.5 && p95 < 1.5, "ratios {median} [{p5}, {p95}]");
+        assert!((out.enclosed_volume() - 1.0).abs() < 1e-12, "volume {}", out.enclosed_volume());
+        // Vertices stay on the cube; the 8 corners survive; six CAD faces remain.
+        let on_cube =
+            |p: &[f64; 3]| p.iter().any(|&x| x == 0.0 || x == 1.0) && p.iter().all(|&x| (0.0..=1.0).contains(&x));
+        assert!(out.vertices().iter().all(on_cube));
+        let corners = out.vertices().iter().filter(|p| p.iter().all(|&x| x == 0.0 || x == 1.0)).count();
+        assert_eq!(corners, 8);
+        let mut ids = out.face_ids().to_vec();
+        ids.sort_unstable();
+        ids.dedup();
+        assert_eq!(ids, [1, 2, 3, 4, 5, 6]);
+    }
+
+    #[test]
+    fn graded_size_gives_graded_triangles_and_coarsening_works() {
+        let h = |p: [f64; 3]| 0.03 + 0.2 * p[0];
+        let fine = remesh(&cube(), &FnSize(h), &RemeshParams::default()).unwrap();
+        let (median, p5, p95) = edge_ratios(&fine, h);
+        assert!((0.75..1.25).contains(&median) && p5 > 0.4 && p95 < 1.6, "ratios {median} [{p5}, {p95}]");
+        // Coarsening the fine mesh back to 0.25 everywhere.
+        let coarse = remesh(&fine, &ConstantSize(0.25), &RemeshParams::default()).unwrap();
+        assert!(
+            coarse.triangles().len() * 5 < fine.triangles().len(),
+            "{} vs {}",
+            coarse.triangles().len(),
+            fine.triangles().len()
+        );
+        assert!((coarse.enclosed_volume() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_sizes_are_typed_errors() {
+        assert!(matches!(
+            remesh(&cube(), &ConstantSize(f64::NAN), &RemeshParams::default()),
+            Err(RemeshError::InvalidSize { .. })
+        ));
+        let params = RemeshParams { max_triangles: 1000, ..RemeshParams::default() };
+        assert!(matches!(
+            remesh(&cube(), &ConstantSize(1e-3), &params),
+            Err(RemeshError::TooManyTriangles { cap: 1000 })
+        ));
+    }
+
+    #[test]
+    fn closest_point_on_a_triangle() {
+        let t = RefTriangle([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+        assert_eq!(t.closest([0.5, 0.5, 3.0]), [0.5, 0.5, 0.0]);
+        assert_eq!(t.closest([-1.0, -1.0, 1.0]), [0.0, 0.0, 0.0]);
+        assert_eq!(t.closest([3.0, -1.0, 0.0]), [2.0, 0.0, 0.0]);
+        assert_eq!(t.closest([1.0, -5.0, 0.0]), [1.0, 0.0, 0.0]);
+        assert_eq!(t.closest([2.0, 2.0, 0.0]), [1.0, 1.0, 0.0]);
+        assert_eq!(t.distance_2(&[0.5, 0.5, 3.0]), 9.0);
+    }
+
+    /// Console reference surfaces remeshed to 2 mm and 4 mm, then filled by TetGen with the
+    /// project's switches: edges follow the size, the volume stays within 0.5 %, and the
+    /// remeshed surface is a valid TetGen input (`remesh` validates it).
+    #[test]
+    fn console_surfaces_are_remeshed_to_the_size_and_tetrahedralize() {
+        use crate::mesh3d::tetgen::{TetgenSwitches, tetrahedralize};
+        use crate::mesh3d::{console_reference_surfaces, surface::StlFaceIds};
+        let Some(files) = console_reference_surfaces() else { return };
+        for path in files.iter().filter(|p| p.ends_with("train/015.stl") || p.ends_with("val/002.stl")) {
+            let (reference, report) = Surface::load(path, StlFaceIds::FromFile).unwrap();
+            for h in [2.0, 4.0] {
+                let start = std::time::Instant::now();
+                let out = remesh(&reference, &ConstantSize(h), &RemeshParams::default()).unwrap();
+                let seconds = start.elapsed().as_secs_f64();
+                let (median, p5, p95) = edge_ratios(&out, |_| h);
+                let volume_change = out.enclosed_volume() / report.enclosed_volume - 1.0;
+                let sizes = vec![h; out.vertices().len()];
+                let tets = tetrahedralize(&out.to_plc(), Some(&sizes), None, &TetgenSwitches::default()).unwrap();
+                println!(
+                    "{} h = {h}: {} -> {} triangles in {seconds:.2} s, edge/h median {median:.2} [p5 {p5:.2}, p95 \
+                     {p95:.2}], volume {volume_change:+.1e}, {} tets",
+                    path.display(),
+                    reference.triangles().len(),
+                    out.triangles().len(),
+                    tets.mesh.num_elements()
+                );
+                assert!((0.85..1.1).contains(&median) && p5 > 0.5 && p95 < 1.35, "{}", path.display());
+                assert!(volume_change.abs() < 5e-3, "{}", path.display());
+                assert!((tets.mesh.total_volume() / out.enclosed_volume() - 1.0).abs() < 1e-9);
+            }
+        }
+    }
+}

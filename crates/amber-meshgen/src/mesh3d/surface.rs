@@ -1,0 +1,812 @@
+//! Closed triangle surfaces with a CAD-face id per triangle: reading (STL, OBJ), welding
+//! duplicate vertices, and the checks TetGen needs of its input — closed, 2-manifold,
+//! consistently oriented with outward normals, free of self-intersections.
+//!
+//! The Console reference surfaces (`data/console/reference_surface/*/NNN.stl`) are binary STL
+//! in mm whose 2-byte facet attribute holds the 1-based CAD face id: read them with
+//! [`StlFaceIds::FromFile`].
+
+use std::cmp::Ordering;
+use std::collections::{HashMap, VecDeque};
+use std::path::{Path, PathBuf};
+
+use super::intersect::intersecting_pairs;
+use super::predicates::orient2d;
+use super::tetgen::Plc;
+
+/// A triangle surface: vertices, triangles (zero-based vertex indices) and the CAD face id of
+/// every triangle. Indices are in range and vertices finite ([`Surface::new`] checks); whether
+/// the surface bounds a solid is what [`Surface::validate`] checks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surface {
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    face_ids: Vec<i32>,
+}
+
+/// Where the CAD face ids of an STL file come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StlFaceIds {
+    /// Binary STL: the 2-byte facet attribute (as gmsh-made reference surfaces store it);
+    /// ASCII STL: the 1-based index of the `solid` block.
+    FromFile,
+    /// Every triangle gets face id 1 (plain STL, attribute ignored).
+    Single,
+}
+
+/// What [`Surface::validate`] found and did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceReport {
+    /// Connected components (separate closed shells).
+    pub components: usize,
+    /// Triangles whose orientation was reversed to make all normals point outward.
+    pub flipped_triangles: usize,
+    /// Enclosed volume (positive).
+    pub enclosed_volume: f64,
+    /// V − E + F.
+    pub euler_characteristic: i64,
+}
+
+impl SurfaceReport {
+    /// Number of handles (through-holes), summed over components: (2·components − χ) / 2.
+    pub fn genus(&self) -> i64 {
+        (2 * self.components as i64 - self.euler_characteristic) / 2
+    }
+}
+
+/// Reading or validating a surface file failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SurfaceError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    /// The file content is malformed.
+    #[error("{path}: {message}")]
+    Parse { path: PathBuf, message: String },
+    /// The extension names no supported format.
+    #[error("{path}: unsupported surface format (expected .stl or .obj)")]
+    UnsupportedFormat { path: PathBuf },
+    /// The file was read but the surface does not bound a solid.
+    #[error("{path}: {source}")]
+    Defect { path: PathBuf, source: SurfaceDefect },
+}
+
+/// Why a surface does not bound a solid (or is malformed).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SurfaceDefect {
+    /// No triangles.
+    #[error("the surface has no triangles")]
+    Empty,
+    /// Array lengths disagree.
+    #[error("{what} has {found} entries, expected {expected}")]
+    LengthMismatch { what: &'static str, expected: usize, found: usize },
+    /// A coordinate is NaN or infinite (`vertex` indexes the input points, or corners of a soup).
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFiniteVertex { vertex: usize },
+    /// A triangle references a missing vertex.
+    #[error("triangle {triangle} references vertex {vertex}, but there are {num_vertices} vertices")]
+    VertexOutOfRange { triangle: usize, vertex: u32, num_vertices: usize },
+    /// Two corners coincide or all three are collinear.
+    #[error("triangle {triangle} (face {face}) near {at:?} is degenerate (repeated or collinear corners)")]
+    DegenerateTriangle { triangle: usize, face: i32, at: [f64; 3] },
+    /// A vertex belongs to no triangle (TetGen would insert it as a free point).
+    #[error("vertex {vertex} at {at:?} belongs to no triangle")]
+    UnusedVertex { vertex: usize, at: [f64; 3] },
+    /// Edges with one triangle: the surface has holes or cracks.
+    #[error("not closed: {count} edges have only one triangle, e.g. {edge:?} at {at:?}")]
+    OpenEdges { count: usize, edge: [u32; 2], at: [f64; 3] },
+    /// Edges with three or more triangles.
+    #[error(
+        "not manifold: {count} edges have more than two triangles, e.g. {edge:?} at {at:?} ({triangles} triangles)"
+    )]
+    NonManifoldEdges { count: usize, edge: [u32; 2], at: [f64; 3], triangles: usize },
+    /// Two or more fans of triangles meet only at a vertex.
+    #[error("not manifold: vertex {vertex} at {at:?} joins {fans} separate fans of triangles")]
+    NonManifoldVertex { vertex: usize, at: [f64; 3], fans: usize },
+    /// A component cannot be oriented consistently (a Möbius-like surface).
+    #[error("not orientable: the component of triangle {triangle} cannot be oriented consistently")]
+    NonOrientable { triangle: usize },
+    /// A closed component encloses no volume.
+    #[error("the component of triangle {triangle} encloses no volume ({volume:e})")]
+    ZeroVolume { triangle: usize, volume: f64 },
+    /// Two triangles without a common vertex intersect.
+    #[error(
+        "self-intersection: triangle {first} (face {first_face}) and triangle {second} (face {second_face}) intersect near {at:?}"
+    )]
+    SelfIntersection { first: usize, first_face: i32, second: usize, second_face: i32, at: [f64; 3] },
+}
+
+impl Surface {
+    /// Builds a surface from indexed triangles, checking lengths, indices, finiteness and that
+    /// no triangle repeats a vertex.
+    pub fn new(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>, face_ids: Vec<i32>) -> Result<Self, SurfaceDefect> {
+        if triangles.is_empty() {
+            return Err(SurfaceDefect::Empty);
+        }
+        if face_ids.len() != triangles.len() {
+            return Err(SurfaceDefect::LengthMismatch {
+                what: "face_ids",
+                expected: triangles.len(),
+                found: face_ids.len(),
+            });
+        }
+        if let Some(vertex) = vertices.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(SurfaceDefect::NonFiniteVertex { vertex });
+        }
+        let num_vertices = vertices.len();
+        for (triangle, t) in triangles.iter().enumerate() {
+            if let Some(&vertex) = t.iter().find(|&&v| v as usize >= num_vertices) {
+                return Err(SurfaceDefect::VertexOutOfRange { triangle, vertex, num_vertices });
+            }
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                return Err(SurfaceDefect::DegenerateTriangle {
+                    triangle,
+                    face: face_ids[triangle],
+                    at: vertices[t[0] as usize],
+                });
+            }
+        }
+        Ok(Self { vertices, triangles, face_ids })
+    }
+
+    /// Builds a surface from a triangle soup (3 corners per triangle, as in STL), merging
+    /// corners closer than `weld_tolerance` (0: only bit-identical positions) into one vertex.
+    pub fn from_triangle_soup(
+        corners: &[[f64; 3]],
+        face_ids: Vec<i32>,
+        weld_tolerance: f64,
+    ) -> Result<Self, SurfaceDefect> {
+        if corners.len() != 3 * face_ids.len() {
+            return Err(SurfaceDefect::LengthMismatch {
+                what: "corners",
+                expected: 3 * face_ids.len(),
+                found: corners.len(),
+            });
+        }
+        if let Some(vertex) = corners.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(SurfaceDefect::NonFiniteVertex { vertex });
+        }
+        let (vertices, index) = weld(corners, weld_tolerance);
+        let triangles = index.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        Self::new(vertices, triangles, face_ids)
+    }
+
+    /// Reads a binary or ASCII STL file (binary when the size matches its facet count).
+    pub fn read_stl(path: impl AsRef<Path>, face_ids: StlFaceIds) -> Result<Self, SurfaceError> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|source| SurfaceError::Io { path: path.into(), source })?;
+        let (corners, ids) =
+            parse_stl(&bytes, face_ids).map_err(|message| SurfaceError::Parse { path: path.into(), message })?;
+        Self::from_triangle_soup(&corners, ids, 0.0)
+            .map_err(|source| SurfaceError::Defect { path: path.into(), source })
+    }
+
+    /// Reads a Wavefront OBJ file: `v` and `f` lines (polygons are fanned into triangles, so
+    /// they must be convex); each `g`/`o` group becomes a face id, 1-based in order of appearance.
+    pub fn read_obj(path: impl AsRef<Path>) -> Result<Self, SurfaceError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| SurfaceError::Io { path: path.into(), source })?;
+        let (corners, ids) = parse_obj(&text).map_err(|message| SurfaceError::Parse { path: path.into(), message })?;
+        Self::from_triangle_soup(&corners, ids, 0.0)
+            .map_err(|source| SurfaceError::Defect { path: path.into(), source })
+    }
+
+    /// Reads an `.stl` or `.obj` file and [validates](Surface::validate) it; every error names the file.
+    pub fn load(path: impl AsRef<Path>, stl_face_ids: StlFaceIds) -> Result<(Self, SurfaceReport), SurfaceError> {
+        let path = path.as_ref();
+        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        let mut surface = match extension.as_deref() {
+            Some("stl") => Self::read_stl(path, stl_face_ids)?,
+            Some("obj") => Self::read_obj(path)?,
+            _ => return Err(SurfaceError::UnsupportedFormat { path: path.into() }),
+        };
+        let report = surface.validate().map_err(|source| SurfaceError::Defect { path: path.into(), source })?;
+        Ok((surface, report))
+    }
+
+    /// Vertex positions.
+    pub fn vertices(&self) -> &[[f64; 3]] {
+        &self.vertices
+    }
+
+    /// Triangles as zero-based vertex indices.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// CAD face id of every triangle.
+    pub fn face_ids(&self) -> &[i32] {
+        &self.face_ids
+    }
+
+    /// Signed enclosed volume (divergence theorem; positive for a closed outward surface).
+    pub fn enclosed_volume(&self) -> f64 {
+        self.volume_of(0..self.triangles.len())
+    }
+
+    /// The surface as TetGen input: one facet per triangle, marker = CAD face id.
+    pub fn to_plc(&self) -> Plc {
+        Plc { points: self.vertices.clone(), triangles: self.triangles.clone(), face_markers: self.face_ids.clone() }
+    }
+
+    /// Checks that the surface bounds a solid: no degenerate triangles or unused vertices,
+    /// closed (every edge in exactly two triangles), 2-manifold at every vertex, orientable,
+    /// free of self-intersections (no two triangles without a common corner meet).
+    /// Re-orients triangles so that every component encloses positive volume (so nested
+    /// shells — cavities — are not supported).
+    pub fn validate(&mut self) -> Result<SurfaceReport, SurfaceDefect> {
+        self.check_triangles_and_vertices()?;
+        let edges = self.manifold_edges()?;
+        self.check_vertex_fans(&edges)?;
+        let (components, flipped_triangles) = self.orient(&edges)?;
+        if let Some(&(first, second)) = intersecting_pairs(&self.vertices, &self.triangles).first() {
+            let at = self.vertices[self.triangles[first][0] as usize];
+            let (first_face, second_face) = (self.face_ids[first], self.face_ids[second]);
+            return Err(SurfaceDefect::SelfIntersection { first, first_face, second, second_face, at });
+        }
+        let euler_characteristic = self.vertices.len() as i64 - edges.len() as i64 + self.triangles.len() as i64;
+        Ok(SurfaceReport {
+            components,
+            flipped_triangles,
+            enclosed_volume: self.enclosed_volume(),
+            euler_characteristic,
+        })
+    }
+
+    fn check_triangles_and_vertices(&self) -> Result<(), SurfaceDefect> {
+        // Exactly collinear corners have collinear projections onto all three coordinate planes.
+        let flat = |p: [f64; 3], i: usize| [p[i], p[(i + 1) % 3]];
+        for (triangle, t) in self.triangles.iter().enumerate() {
+            let [a, b, c] = t.map(|v| self.vertices[v as usize]);
+            if (0..3).all(|i| orient2d(flat(a, i), flat(b, i), flat(c, i)) == Ordering::Equal) {
+                return Err(SurfaceDefect::DegenerateTriangle { triangle, face: self.face_ids[triangle], at: a });
+            }
+        }
+        let mut used = vec![false; self.vertices.len()];
+        self.triangles.iter().flatten().for_each(|&v| used[v as usize] = true);
+        match used.iter().position(|&u| !u) {
+            Some(vertex) => Err(SurfaceDefect::UnusedVertex { vertex, at: self.vertices[vertex] }),
+            None => Ok(()),
+        }
+    }
+
+    /// Every undirected edge with its two triangles, or the first open / non-manifold edge.
+    fn manifold_edges(&self) -> Result<Vec<SharedEdge>, SurfaceDefect> {
+        let mut uses: Vec<([u32; 2], u32)> = Vec::with_capacity(3 * self.triangles.len());
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                uses.push(([a.min(b), a.max(b)], t as u32));
+            }
+        }
+        uses.sort_unstable();
+        let groups: Vec<&[([u32; 2], u32)]> = uses.chunk_by(|x, y| x.0 == y.0).collect();
+        let midpoint = |[a, b]: [u32; 2]| {
+            let (p, q) = (self.vertices[a as usize], self.vertices[b as usize]);
+            [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]))
+        };
+        let open: Vec<_> = groups.iter().filter(|g| g.len() == 1).collect();
+        if let Some(g) = open.first() {
+            return Err(SurfaceDefect::OpenEdges { count: open.len(), edge: g[0].0, at: midpoint(g[0].0) });
+        }
+        let crowded: Vec<_> = groups.iter().filter(|g| g.len() > 2).collect();
+        if let Some(g) = crowded.first() {
+            let (edge, triangles) = (g[0].0, g.len());
+            return Err(SurfaceDefect::NonManifoldEdges { count: crowded.len(), edge, at: midpoint(edge), triangles });
+        }
+        Ok(groups.iter().map(|g| SharedEdge { vertices: g[0].0, triangles: [g[0].1, g[1].1] }).collect())
+    }
+
+    /// With every edge in two triangles, a vertex is manifold iff its triangles form a single
+    /// fan, i.e. they are connected through the edges at that vertex. Union-find over corners.
+    fn check_vertex_fans(&self, edges: &[SharedEdge]) -> Result<(), SurfaceDefect> {
+        let corner =
+            |t: u32, v: u32| 3 * t as usize + self.triangles[t as usize].iter().position(|&x| x == v).unwrap_or(0);
+        let mut parent: Vec<usize> = (0..3 * self.triangles.len()).collect();
+        for e in edges {
+            for v in e.vertices {
+                let (x, y) =
+                    (find(&mut parent, corner(e.triangles[0], v)), find(&mut parent, corner(e.triangles[1], v)));
+                parent[x] = y;
+            }
+        }
+        let mut fans = vec![0usize; self.vertices.len()];
+        for c in 0..parent.len() {
+            // Only corners of the same vertex were joined, so each root is one fan of its vertex.
+            if find(&mut parent, c) == c {
+                fans[self.triangles[c / 3][c % 3] as usize] += 1;
+            }
+        }
+        match fans.iter().position(|&n| n > 1) {
+            Some(vertex) => {
+                Err(SurfaceDefect::NonManifoldVertex { vertex, at: self.vertices[vertex], fans: fans[vertex] })
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Makes neighbouring triangles agree (breadth-first over shared edges), then turns every
+    /// component that encloses negative volume. Returns (components, flipped triangles).
+    fn orient(&mut self, edges: &[SharedEdge]) -> Result<(usize, usize), SurfaceDefect> {
+        let n = self.triangles.len();
+        let mut neighbours: Vec<Vec<(u32, bool)>> = vec![Vec::with_capacity(3); n];
+        for e in edges {
+            let [t, u] = e.triangles;
+            // Consistent neighbours run through their shared edge in opposite directions.
+            let same = self.runs_forward(t, e.vertices) == self.runs_forward(u, e.vertices);
+            neighbours[t as usize].push((u, same));
+            neighbours[u as usize].push((t, same));
+        }
+        let mut flip: Vec<Option<bool>> = vec![None; n];
+        let mut components = 0;
+        let mut flipped = 0;
+        for seed in 0..n {
+            if flip[seed].is_some() {
+                continue;
+            }
+            components += 1;
+            flip[seed] = Some(false);
+            let mut members = vec![seed];
+            let mut queue = VecDeque::from([seed]);
+            while let Some(t) = queue.pop_front() {
+                let ft = flip[t].unwrap_or(false);
+                for &(u, same) in &neighbours[t] {
+                    let want = ft ^ same;
+                    match flip[u as usize] {
+                        None => {
+                            flip[u as usize] = Some(want);
+                            members.push(u as usize);
+                            queue.push_back(u as usize);
+                        }
+                        Some(have) if have != want => return Err(SurfaceDefect::NonOrientable { triangle: seed }),
+                        Some(_) => {}
+                    }
+                }
+            }
+            for &t in &members {
+                if flip[t] == Some(true) {
+                    self.triangles[t].swap(1, 2);
+                }
+            }
+            let volume = self.volume_of(members.iter().copied());
+            if volume == 0.0 || !volume.is_finite() {
+                return Err(SurfaceDefect::ZeroVolume { triangle: seed, volume });
+            }
+            let outward = volume > 0.0;
+            if !outward {
+                members.iter().for_each(|&t| self.triangles[t].swap(1, 2));
+            }
+            flipped += members.iter().filter(|&&t| flip[t] == Some(outward)).count();
+        }
+        Ok((components, flipped))
+    }
+
+    /// Whether triangle `t` lists edge [a, b] as a → b.
+    fn runs_forward(&self, t: u32, [a, b]: [u32; 2]) -> bool {
+        let tri = self.triangles[t as usize];
+        (0..3).any(|k| tri[k] == a && tri[(k + 1) % 3] == b)
+    }
+
+    /// Signed volume enclosed by the given triangles, relative to their first vertex to keep
+    /// the sum well conditioned away from the origin.
+    fn volume_of(&self, triangles: impl Iterator<Item = usize>) -> f64 {
+        let mut triangles = triangles.peekable();
+        let Some(&first) = triangles.peek() else { return 0.0 };
+        let r = self.vertices[self.triangles[first][0] as usize];
+        triangles
+            .map(|t| {
+                let [a, b, c] = self.triangles[t].map(|v| {
+                    let p = self.vertices[v as usize];
+                    [p[0] - r[0], p[1] - r[1], p[2] - r[2]]
+                });
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum()
+    }
+}
+
+/// An undirected edge (sorted vertices) and the two triangles that share it.
+struct SharedEdge {
+    vertices: [u32; 2],
+    triangles: [u32; 2],
+}
+
+fn find(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
+}
+
+/// Merges corners into vertices: bit-identical positions for `tolerance == 0`, else any two
+/// within `tolerance` (grid hashing with cells of that size; the first vertex found wins).
+fn weld(corners: &[[f64; 3]], tolerance: f64) -> (Vec<[f64; 3]>, Vec<u32>) {
+    let mut vertices: Vec<[f64; 3]> = Vec::new();
+    let mut index = Vec::with_capacity(corners.len());
+    if tolerance <= 0.0 {
+        // `+ 0.0` turns −0.0 into +0.0 so that both hash alike.
+        let mut seen: HashMap<[u64; 3], u32> = HashMap::with_capacity(corners.len() / 2);
+        for p in corners {
+            let id = *seen.entry(p.map(|x| (x + 0.0).to_bits())).or_insert_with(|| {
+                vertices.push(*p);
+                vertices.len() as u32 - 1
+            });
+            index.push(id);
+        }
+        return (vertices, index);
+    }
+    let cell = |p: &[f64; 3]| p.map(|x| (x / tolerance).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    for p in corners {
+        let c = cell(p);
+        let near = (0..27).find_map(|k: i64| {
+            let key = [c[0] + k % 3 - 1, c[1] + (k / 3) % 3 - 1, c[2] + k / 9 - 1];
+            grid.get(&key)?.iter().copied().find(|&v| {
+                let q = vertices[v as usize];
+                (0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>() <= tolerance * tolerance
+            })
+        });
+        let id = near.unwrap_or_else(|| {
+            vertices.push(*p);
+            let id = vertices.len() as u32 - 1;
+            grid.entry(c).or_default().push(id);
+            id
+        });
+        index.push(id);
+    }
+    (vertices, index)
+}
+
+/// Corners and face ids of an STL file; errors say where.
+fn parse_stl(bytes: &[u8], face_ids: StlFaceIds) -> Result<(Vec<[f64; 3]>, Vec<i32>), String> {
+    if bytes.len() >= 84 {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
+        if bytes.len() as u64 == 84 + 50 * n as u64 {
+            return Ok(parse_binary_stl(&bytes[84..], n, face_ids));
+        }
+    }
+    if bytes.trim_ascii_start().starts_with(b"solid") {
+        let text = std::str::from_utf8(bytes).map_err(|e| format!("ASCII STL is not valid UTF-8: {e}"))?;
+        return parse_ascii_stl(text, face_ids);
+    }
+    Err(format!(
+        "not an STL file: {} bytes match no binary facet count and the text does not start with `solid`",
+        bytes.len()
+    ))
+}
+
+fn parse_binary_stl(facets: &[u8], n: usize, face_ids: StlFaceIds) -> (Vec<[f64; 3]>, Vec<i32>) {
+    let f32_at = |b: &[u8], i: usize| f32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]) as f64;
+    let mut corners = Vec::with_capacity(3 * n);
+    let mut ids = Vec::with_capacity(n);
+    for facet in facets.chunks_exact(50) {
+        // Bytes 0..12 hold the normal, which is recomputed from the corners when needed.
+        for k in 0..3 {
+            let at = 12 + 12 * k;
+            corners.push([f32_at(facet, at), f32_at(facet, at + 4), f32_at(facet, at + 8)]);
+        }
+        ids.push(match face_ids {
+            StlFaceIds::FromFile => u16::from_le_bytes([facet[48], facet[49]]) as i32,
+            StlFaceIds::Single => 1,
+        });
+    }
+    (corners, ids)
+}
+
+fn parse_ascii_stl(text: &str, face_ids: StlFaceIds) -> Result<(Vec<[f64; 3]>, Vec<i32>), String> {
+    let mut corners = Vec::new();
+    let mut ids = Vec::new();
+    let mut solid = 0;
+    let mut facet: Vec<[f64; 3]> = Vec::with_capacity(3);
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("solid") => solid += 1,
+            Some("facet") => facet.clear(),
+            Some("vertex") => facet.push(parse_coordinates(words).map_err(|e| format!("line {}: {e}", number + 1))?),
+            Some("endfacet") => {
+                if facet.len() != 3 {
+                    return Err(format!(
+                        "line {}: facet with {} vertices (only triangles are supported)",
+                        number + 1,
+                        facet.len()
+                    ));
+                }
+                corners.append(&mut facet);
+                ids.push(if face_ids == StlFaceIds::FromFile { solid } else { 1 });
+            }
+            _ => {}
+        }
+    }
+    Ok((corners, ids))
+}
+
+fn parse_coordinates<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<[f64; 3], String> {
+    let mut p = [0.0; 3];
+    for x in &mut p {
+        let word = words.next().ok_or("expected 3 coordinates")?;
+        *x = word.parse().map_err(|_| format!("`{word}` is not a number"))?;
+    }
+    Ok(p)
+}
+
+fn parse_obj(text: &str) -> Result<(Vec<[f64; 3]>, Vec<i32>), String> {
+    let mut vertices: Vec<[f64; 3]> = Vec::new();
+    let mut corners = Vec::new();
+    let mut ids = Vec::new();
+    let mut group_ids: HashMap<String, i32> = HashMap::new();
+    let mut group = String::new();
+    for (number, line) in text.lines().enumerate() {
+        let at = |e: String| format!("line {}: {e}", number + 1);
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => vertices.push(parse_coordinates(words).map_err(at)?),
+            Some("g" | "o") => group = words.collect::<Vec<_>>().join(" "),
+            Some("f") => {
+                let polygon = words.map(|w| obj_index(w, vertices.len())).collect::<Result<Vec<_>, _>>().map_err(at)?;
+                if polygon.len() < 3 {
+                    return Err(at(format!("face with {} vertices", polygon.len())));
+                }
+                let next_id = group_ids.len() as i32 + 1;
+                let id = *group_ids.entry(group.clone()).or_insert(next_id);
+                for k in 1..polygon.len() - 1 {
+                    corners.extend([polygon[0], polygon[k], polygon[k + 1]].map(|v| vertices[v]));
+                    ids.push(id);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok((corners, ids))
+}
+
+/// A face corner `v`, `v/vt`, `v//vn` or `v/vt/vn`; 1-based, negative counts back from the end.
+fn obj_index(word: &str, num_vertices: usize) -> Result<usize, String> {
+    let v = word.split('/').next().unwrap_or(word);
+    let i: i64 = v.parse().map_err(|_| format!("`{word}` is not a vertex index"))?;
+    let index = if i < 0 { num_vertices as i64 + i } else { i - 1 };
+    if (0..num_vertices as i64).contains(&index) {
+        Ok(index as usize)
+    } else {
+        Err(format!("vertex index {i} out of range (1..={num_vertices})"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh3d::console_reference_surfaces;
+
+    const CUBE_OBJ: &str = "# unit cube of quads in three groups; 'top' is inside out\n\
+        v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+        g bottom\nf 1 4 3 2\ng top\nf 5 8 7 6\n\
+        g sides\nf 1 2 6 5\nf 2/1 3/2 7/3 6/4\nf 3//1 4//1 8//1 7//1\nf -1 -5 -8 -4\n";
+
+    fn obj_cube() -> Surface {
+        let (corners, ids) = parse_obj(CUBE_OBJ).unwrap();
+        Surface::from_triangle_soup(&corners, ids, 0.0).unwrap()
+    }
+
+    /// Binary STL bytes of the given triangles with the given attributes.
+    fn binary_stl(corners: &[[f64; 3]], attributes: &[u16]) -> Vec<u8> {
+        let mut bytes = vec![b' '; 80];
+        bytes.extend((attributes.len() as u32).to_le_bytes());
+        for (t, a) in attributes.iter().enumerate() {
+            bytes.extend([0u8; 12]);
+            for p in &corners[3 * t..3 * t + 3] {
+                p.iter().for_each(|&x| bytes.extend((x as f32).to_le_bytes()));
+            }
+            bytes.extend(a.to_le_bytes());
+        }
+        bytes
+    }
+
+    fn soup(s: &Surface) -> Vec<[f64; 3]> {
+        s.triangles().iter().flat_map(|t| t.map(|v| s.vertices()[v as usize])).collect()
+    }
+
+    #[test]
+    fn obj_cube_is_welded_validated_and_turned_outward() {
+        let mut s = obj_cube();
+        assert_eq!((s.vertices().len(), s.triangles().len()), (8, 12));
+        let mut ids = s.face_ids().to_vec();
+        ids.dedup();
+        assert_eq!(ids, [1, 2, 3]);
+        let report = s.validate().unwrap();
+        assert_eq!(report.components, 1);
+        assert_eq!(report.flipped_triangles, 2);
+        assert_eq!((report.euler_characteristic, report.genus()), (2, 0));
+        assert!((report.enclosed_volume - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn inside_out_surface_is_reversed_whole() {
+        let mut s = obj_cube();
+        s.validate().unwrap();
+        s.triangles.iter_mut().for_each(|t| t.swap(0, 1));
+        assert!(s.enclosed_volume() < 0.0);
+        assert_eq!(s.validate().unwrap().flipped_triangles, 12);
+        assert!((s.enclosed_volume() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn binary_and_ascii_stl_carry_face_ids() {
+        let cube = obj_cube();
+        let corners = soup(&cube);
+        let attributes: Vec<u16> = (0..12).map(|t| t / 2 + 1).collect();
+        let (c, ids) = parse_stl(&binary_stl(&corners, &attributes), StlFaceIds::FromFile).unwrap();
+        assert_eq!((c, ids.clone()), (corners.clone(), attributes.iter().map(|&a| a as i32).collect::<Vec<_>>()));
+        let (_, single) = parse_stl(&binary_stl(&corners, &attributes), StlFaceIds::Single).unwrap();
+        assert!(single.iter().all(|&i| i == 1));
+        let mut ascii = String::from("solid a\n");
+        for (t, tri) in corners.chunks(3).enumerate() {
+            if t == 6 {
+                ascii += "endsolid a\nsolid b\n";
+            }
+            ascii += "  facet normal 0 0 0\n    outer loop\n";
+            tri.iter().for_each(|p| ascii += &format!("      vertex {} {} {}\n", p[0], p[1], p[2]));
+            ascii += "    endloop\n  endfacet\n";
+        }
+        ascii += "endsolid b\n";
+        let (c, ids) = parse_stl(ascii.as_bytes(), StlFaceIds::FromFile).unwrap();
+        assert_eq!(c, corners);
+        assert_eq!(ids, [1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2]);
+    }
+
+    #[test]
+    fn file_errors_name_the_file() {
+        let dir = std::env::temp_dir().join(format!("amber-surface-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bad = dir.join("bad.obj");
+        std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap();
+        let err = Surface::load(&bad, StlFaceIds::Single).unwrap_err().to_string();
+        assert!(err.contains("bad.obj") && err.contains("line 3"), "{err}");
+        // A cube missing one triangle: readable, but not closed.
+        let open = dir.join("open.stl");
+        let corners = soup(&obj_cube());
+        std::fs::write(&open, binary_stl(&corners[..33], &[1; 11])).unwrap();
+        let err = Surface::load(&open, StlFaceIds::FromFile).unwrap_err();
+        assert!(
+            matches!(&err, SurfaceError::Defect { source: SurfaceDefect::OpenEdges { count: 3, .. }, .. }),
+            "{err}"
+        );
+        assert!(err.to_string().contains("open.stl"));
+        let missing = Surface::load(dir.join("missing.stl"), StlFaceIds::FromFile).unwrap_err();
+        assert!(matches!(missing, SurfaceError::Io { .. }));
+        assert!(matches!(
+            Surface::load(dir.join("x.ply"), StlFaceIds::FromFile),
+            Err(SurfaceError::UnsupportedFormat { .. })
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn tolerance_welding_closes_cracks() {
+        let mut corners = soup(&obj_cube());
+        corners[0][0] += 1e-9;
+        let mut exact = Surface::from_triangle_soup(&corners, vec![1; 12], 0.0).unwrap();
+        assert_eq!(exact.vertices().len(), 9);
+        assert!(matches!(exact.validate(), Err(SurfaceDefect::OpenEdges { .. })));
+        let mut welded = Surface::from_triangle_soup(&corners, vec![1; 12], 1e-6).unwrap();
+        assert_eq!(welded.vertices().len(), 8);
+        welded.validate().unwrap();
+    }
+
+    #[test]
+    fn non_manifold_and_degenerate_surfaces_are_rejected() {
+        let cube = obj_cube();
+        let corners = soup(&cube);
+        // Two cubes sharing one corner vertex: every edge is fine, the vertex is not.
+        let mut two = corners.clone();
+        two.extend(corners.iter().map(|p| [p[0] + 1.0, p[1] + 1.0, p[2] + 1.0]));
+        let mut s = Surface::from_triangle_soup(&two, vec![1; 24], 0.0).unwrap();
+        assert!(matches!(s.validate(), Err(SurfaceDefect::NonManifoldVertex { fans: 2, .. })), "{:?}", s.validate());
+        // The same triangle twice: three triangles on each of its edges.
+        let mut three = corners.clone();
+        three.extend_from_slice(&corners[..3]);
+        let mut s = Surface::from_triangle_soup(&three, vec![1; 13], 0.0).unwrap();
+        assert!(matches!(s.validate(), Err(SurfaceDefect::NonManifoldEdges { count: 3, .. })));
+        // A collinear triangle.
+        let mut flat = corners.clone();
+        flat.extend([[0.0, 0.0, 0.0], [0.5, 0.5, 0.5], [0.25, 0.25, 0.25]]);
+        let mut s = Surface::from_triangle_soup(&flat, vec![1; 13], 0.0).unwrap();
+        assert!(matches!(s.validate(), Err(SurfaceDefect::DegenerateTriangle { triangle: 12, .. })));
+        assert!(matches!(
+            Surface::new(vec![[0.0; 3]; 3], vec![[0, 1, 1]], vec![1]),
+            Err(SurfaceDefect::DegenerateTriangle { .. })
+        ));
+    }
+
+    #[test]
+    fn overlapping_shells_are_a_self_intersection() {
+        let corners = soup(&obj_cube());
+        let mut two = corners.clone();
+        two.extend(corners.iter().map(|p| [p[0] + 0.5, p[1] + 0.25, p[2] + 0.125]));
+        let mut s = Surface::from_triangle_soup(&two, (0..24).map(|t| t / 12 + 1).collect(), 0.0).unwrap();
+        let err = s.validate().unwrap_err();
+        assert!(matches!(err, SurfaceDefect::SelfIntersection { first_face: 1, second_face: 2, .. }), "{err}");
+        // Apart, they are two valid components.
+        let mut apart = corners.clone();
+        apart.extend(corners.iter().map(|p| [p[0] + 2.0, p[1], p[2]]));
+        let mut s = Surface::from_triangle_soup(&apart, vec![1; 24], 0.0).unwrap();
+        let report = s.validate().unwrap();
+        assert_eq!((report.components, report.genus()), (2, 0));
+        assert!((report.enclosed_volume - 2.0).abs() < 1e-14);
+    }
+
+    /// A number from the flat JSON beside each surface (`"key": value`).
+    fn json_number(path: &Path, key: &str) -> f64 {
+        let text = std::fs::read_to_string(path.with_extension("json")).unwrap();
+        let rest = &text[text.find(&format!("\"{key}\":")).unwrap_or_else(|| panic!("{key} in {}", path.display()))..];
+        let value = rest[key.len() + 3..].trim_start();
+        value[..value.find([',', '\n', '}']).unwrap_or(value.len())].trim().parse().unwrap()
+    }
+
+    #[test]
+    fn shipped_console_surfaces_are_closed_manifold_outward_and_intersection_free() {
+        use rayon::prelude::*;
+        let Some(files) = console_reference_surfaces() else { return };
+        let lines: Vec<String> = files
+            .par_iter()
+            .map(|path| {
+                let start = std::time::Instant::now();
+                let (surface, report) = Surface::load(path, StlFaceIds::FromFile).unwrap_or_else(|e| panic!("{e}"));
+                let expected_volume = json_number(path, "enclosed_volume_mm3");
+                assert_eq!(report.components, 1, "{}", path.display());
+                assert_eq!(report.genus(), json_number(path, "genus") as i64, "{}", path.display());
+                assert!(report.enclosed_volume > 0.0);
+                assert!((report.enclosed_volume / expected_volume - 1.0).abs() < 1e-6, "{}", path.display());
+                assert!(surface.face_ids().iter().all(|&id| id >= 1));
+                format!(
+                    "{}: {} triangles, {} CAD faces, {} flipped, genus {}, {:.1} mm³ (json {expected_volume:.1}), {:.0} ms",
+                    path.display(),
+                    surface.triangles().len(),
+                    surface.face_ids().iter().max().unwrap_or(&0),
+                    report.flipped_triangles,
+                    report.genus(),
+                    report.enclosed_volume,
+                    start.elapsed().as_secs_f64() * 1e3
+                )
+            })
+            .collect();
+        lines.iter().for_each(|l| println!("{l}"));
+    }
+
+    /// TetGen on an un-adapted reference surface with `-pq1.4` and a coarse 5 mm size at every
+    /// surface point: the tets fill the enclosed volume and the boundary keeps its face ids.
+    /// Returns a one-line summary with tets and time.
+    fn tetrahedralize_reference_surface(path: &Path) -> String {
+        use crate::mesh3d::tetgen::{TetgenSwitches, tetrahedralize};
+        let (surface, report) = Surface::load(path, StlFaceIds::FromFile).unwrap_or_else(|e| panic!("{e}"));
+        let sizes = vec![5.0; surface.vertices().len()];
+        let start = std::time::Instant::now();
+        let out = tetrahedralize(&surface.to_plc(), Some(&sizes), None, &TetgenSwitches::plain_quality(1.4))
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let seconds = start.elapsed().as_secs_f64();
+        assert!((out.mesh.total_volume() / report.enclosed_volume - 1.0).abs() < 1e-9, "{}", path.display());
+        let ids: std::collections::HashSet<i32> = surface.face_ids().iter().copied().collect();
+        assert!(out.boundary_markers.iter().all(|m| ids.contains(m)));
+        let min_dihedral = out.mesh.min_angles().into_iter().fold(f64::INFINITY, f64::min);
+        format!(
+            "{}: {} surface triangles -> {} tets, {} boundary triangles, {:.2} s, min dihedral {min_dihedral:.1}°",
+            path.display(),
+            surface.triangles().len(),
+            out.mesh.num_elements(),
+            out.boundary.len(),
+            seconds
+        )
+    }
+
+    #[test]
+    fn small_console_surfaces_tetrahedralize() {
+        let Some(files) = console_reference_surfaces() else { return };
+        for path in files.iter().filter(|p| p.ends_with("train/002.stl") || p.ends_with("val/002.stl")) {
+            println!("{}", tetrahedralize_reference_surface(path));
+        }
+    }
+}
