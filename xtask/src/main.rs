@@ -7,6 +7,7 @@ mod bench_fem;
 mod bench_mesher;
 mod bench_metrics;
 mod dataset;
+mod reference_distances;
 mod report;
 
 use clap::{Parser, Subcommand};
@@ -25,6 +26,8 @@ enum Command {
     Bench(Bench),
     /// Generate a dataset split under data/ (cached: existing identical files are kept).
     Dataset(dataset::Args),
+    /// d(M⁰, M*) and d(M̂, M*) on a dataset split: the anchors of the normalised DCD.
+    ReferenceDistances(reference_distances::Args),
 }
 
 #[derive(Subcommand)]
@@ -45,5 +48,6 @@ fn main() -> anyhow::Result<()> {
         Command::Bench(Bench::Metrics(args)) => bench_metrics::run(args),
         Command::Bench(Bench::Fem(args)) => bench_fem::run(args),
         Command::Dataset(args) => dataset::run(args),
+        Command::ReferenceDistances(args) => reference_distances::run(args),
     }
 }
