@@ -1,0 +1,131 @@
+//! The network's configuration (serde): widths, depth, output transform; the paper's values as defaults.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{MpnError, Result};
+
+/// How the decoder's scalar output `z` becomes the predicted element size.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OutputTransform {
+    /// `softplus(z)`: the paper's positive size, trained with MSE on raw sizes.
+    #[default]
+    Softplus,
+    /// `z` unchanged (the "no softplus" ablation).
+    None,
+    /// `exp(z)`: for regressing log sizes (`z` is trained against `log y`).
+    Exp,
+}
+
+/// Hyper-parameters of the message passing network (spec §5). The defaults are the paper's
+/// Poisson configuration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MpnConfig {
+    /// Input features per node (Poisson: area, mean u, std u, f).
+    pub node_features: usize,
+    /// Input features per directed edge (Poisson: midpoint distance).
+    pub edge_features: usize,
+    /// Latent width D of every node and edge state.
+    pub latent_dim: usize,
+    /// Message-passing steps L, each with its own weights.
+    pub steps: usize,
+    /// Probability of dropping each directed edge (self-loops included) in training mode.
+    pub edge_dropout: f64,
+    pub output: OutputTransform,
+}
+
+impl Default for MpnConfig {
+    fn default() -> Self {
+        Self::poisson()
+    }
+}
+
+impl MpnConfig {
+    /// The paper's Poisson network: 4 node features, 1 edge feature, D = 64, L = 10
+    /// (300,673 parameters).
+    pub fn poisson() -> Self {
+        Self {
+            node_features: 4,
+            edge_features: 1,
+            latent_dim: 64,
+            steps: 10,
+            edge_dropout: 0.1,
+            output: OutputTransform::Softplus,
+        }
+    }
+
+    /// The reference code's Console network: 1 node feature, 3 edge features, D = 128.
+    pub fn console() -> Self {
+        Self {
+            node_features: 1,
+            edge_features: 3,
+            latent_dim: 128,
+            ..Self::poisson()
+        }
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: &str| Err(MpnError::InvalidConfig(m.to_owned()));
+        if self.node_features == 0 || self.edge_features == 0 || self.latent_dim == 0 {
+            return bad("feature counts and latent_dim must be positive");
+        }
+        if !(0.0..1.0).contains(&self.edge_dropout) {
+            return bad("edge_dropout must be in [0, 1)");
+        }
+        Ok(())
+    }
+
+    /// Number of trainable scalars: encoders, L × (edge MLP 3D→D→D, node MLP 2D→D→D, two
+    /// affine LayerNorms), decoder D→D→D→1.
+    pub fn num_parameters(&self) -> usize {
+        let d = self.latent_dim;
+        let linear = |i: usize, o: usize| i * o + o;
+        let step = linear(3 * d, d) + linear(d, d) + linear(2 * d, d) + linear(d, d) + 2 * 2 * d;
+        linear(self.node_features, d)
+            + linear(self.edge_features, d)
+            + self.steps * step
+            + linear(d, d)
+            + linear(d, d)
+            + linear(d, 1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_parameter_counts() {
+        assert_eq!(MpnConfig::poisson().num_parameters(), 300_673);
+        assert_eq!(MpnConfig::console().num_parameters(), 1_191_041);
+    }
+
+    #[test]
+    fn json_round_trip_and_defaults() {
+        let c = MpnConfig {
+            output: OutputTransform::Exp,
+            ..MpnConfig::console()
+        };
+        let back: MpnConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
+        assert_eq!(back, c);
+        let partial: MpnConfig =
+            serde_json::from_str(r#"{"latent_dim": 32, "output": "none"}"#).unwrap();
+        assert_eq!(
+            partial,
+            MpnConfig {
+                latent_dim: 32,
+                output: OutputTransform::None,
+                ..MpnConfig::poisson()
+            }
+        );
+        assert!(
+            MpnConfig {
+                edge_dropout: 1.0,
+                ..MpnConfig::poisson()
+            }
+            .validate()
+            .is_err()
+        );
+    }
+}

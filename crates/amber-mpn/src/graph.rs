@@ -1,0 +1,255 @@
+//! The graph as the network sees it: feature tensors plus the edge index in the two sorted
+//! orders the fused ops need.
+
+use std::sync::Arc;
+
+use amber_graph::GraphBatch;
+use candle_core::{DType, Device, Tensor};
+use rand::Rng;
+
+use crate::error::{MpnError, Result};
+
+/// Directed edges (self-loops included) of a graph, sorted by destination, with the CSR index of
+/// both endpoints: edges into `v` are `dst_offsets[v]..dst_offsets[v + 1]`, edges out of `v` are
+/// `by_src[src_offsets[v]..src_offsets[v + 1]]`.
+#[derive(Debug)]
+pub struct Topology {
+    num_nodes: usize,
+    src: Vec<u32>,
+    dst: Vec<u32>,
+    dst_offsets: Vec<u32>,
+    by_src: Vec<u32>,
+    src_offsets: Vec<u32>,
+}
+
+impl Topology {
+    /// Checks that `dst` is sorted, `dst_offsets` is its CSR index and every endpoint exists.
+    pub fn new(
+        num_nodes: usize,
+        src: Vec<u32>,
+        dst: Vec<u32>,
+        dst_offsets: Vec<u32>,
+    ) -> Result<Self> {
+        let bad = |m: String| Err(MpnError::InvalidGraph(m));
+        if num_nodes > u32::MAX as usize || src.len() > u32::MAX as usize {
+            return bad("more than 2^32 nodes or edges".into());
+        }
+        if src.len() != dst.len() {
+            return bad(format!(
+                "{} edge sources but {} destinations",
+                src.len(),
+                dst.len()
+            ));
+        }
+        if dst_offsets.len() != num_nodes + 1
+            || dst_offsets[0] != 0
+            || dst_offsets[num_nodes] as usize != dst.len()
+        {
+            return bad(format!(
+                "dst_offsets must have {} entries from 0 to {}",
+                num_nodes + 1,
+                dst.len()
+            ));
+        }
+        for v in 0..num_nodes {
+            let (lo, hi) = (dst_offsets[v] as usize, dst_offsets[v + 1] as usize);
+            if lo > hi {
+                return bad(format!("dst_offsets decreases at node {v}"));
+            }
+            if let Some(k) = (lo..hi).find(|&k| dst[k] as usize != v) {
+                return bad(format!(
+                    "edge {k} ends at node {} but lies in the segment of node {v}",
+                    dst[k]
+                ));
+            }
+        }
+        if let Some(k) = src.iter().position(|&s| s as usize >= num_nodes) {
+            return bad(format!("edge {k} starts at node {} of {num_nodes}", src[k]));
+        }
+        Ok(Self::from_sorted(num_nodes, src, dst, dst_offsets))
+    }
+
+    /// Builds the source-sorted index (a stable counting sort) of an already valid edge list.
+    fn from_sorted(num_nodes: usize, src: Vec<u32>, dst: Vec<u32>, dst_offsets: Vec<u32>) -> Self {
+        let mut src_offsets = vec![0u32; num_nodes + 1];
+        for &s in &src {
+            src_offsets[s as usize + 1] += 1;
+        }
+        for v in 0..num_nodes {
+            src_offsets[v + 1] += src_offsets[v];
+        }
+        let mut next = src_offsets.clone();
+        let mut by_src = vec![0u32; src.len()];
+        for (k, &s) in src.iter().enumerate() {
+            by_src[next[s as usize] as usize] = k as u32;
+            next[s as usize] += 1;
+        }
+        Self {
+            num_nodes,
+            src,
+            dst,
+            dst_offsets,
+            by_src,
+            src_offsets,
+        }
+    }
+
+    pub fn num_nodes(&self) -> usize {
+        self.num_nodes
+    }
+    pub fn num_edges(&self) -> usize {
+        self.src.len()
+    }
+    pub fn src(&self) -> &[u32] {
+        &self.src
+    }
+    pub fn dst(&self) -> &[u32] {
+        &self.dst
+    }
+    pub fn dst_offsets(&self) -> &[u32] {
+        &self.dst_offsets
+    }
+    /// Edge ids sorted by source node.
+    pub fn by_src(&self) -> &[u32] {
+        &self.by_src
+    }
+    pub fn src_offsets(&self) -> &[u32] {
+        &self.src_offsets
+    }
+
+    /// Drops every directed edge (self-loops included) independently with probability `p`
+    /// (none for `p ≤ 0`, all for `p ≥ 1`); returns the remaining graph and the ids of the kept
+    /// edges.
+    pub fn drop_edges<R: Rng + ?Sized>(&self, p: f64, rng: &mut R) -> (Self, Vec<u32>) {
+        let kept: Vec<u32> = (0..self.num_edges() as u32)
+            .filter(|_| rng.random::<f64>() >= p)
+            .collect();
+        let src = kept.iter().map(|&k| self.src[k as usize]).collect();
+        let dst: Vec<u32> = kept.iter().map(|&k| self.dst[k as usize]).collect();
+        let mut dst_offsets = vec![0u32; self.num_nodes + 1];
+        for &d in &dst {
+            dst_offsets[d as usize + 1] += 1;
+        }
+        for v in 0..self.num_nodes {
+            dst_offsets[v + 1] += dst_offsets[v];
+        }
+        (
+            Self::from_sorted(self.num_nodes, src, dst, dst_offsets),
+            kept,
+        )
+    }
+}
+
+/// Input of one forward pass: normalised node and edge features (rows in the order of the
+/// topology) on the network's device and dtype.
+#[derive(Clone, Debug)]
+pub struct GraphInput {
+    pub node_features: Tensor,
+    pub edge_features: Tensor,
+    pub topology: Arc<Topology>,
+}
+
+impl GraphInput {
+    /// Validates a batch and uploads it with the given dtype.
+    pub fn from_batch(batch: &GraphBatch, dtype: DType, device: &Device) -> Result<Self> {
+        let n = batch.num_nodes;
+        let e = batch.num_edges;
+        if batch.node_features.len() != n * batch.node_dim {
+            return Err(MpnError::InvalidGraph(format!(
+                "{} node feature values for {n} nodes × {} features",
+                batch.node_features.len(),
+                batch.node_dim
+            )));
+        }
+        if batch.edge_features.len() != e * batch.edge_dim || batch.edge_src.len() != e {
+            return Err(MpnError::InvalidGraph(format!(
+                "{} edge feature values and {} sources for {e} edges × {} features",
+                batch.edge_features.len(),
+                batch.edge_src.len(),
+                batch.edge_dim
+            )));
+        }
+        let topology = Topology::new(
+            n,
+            batch.edge_src.clone(),
+            batch.edge_dst.clone(),
+            batch.dst_offsets.clone(),
+        )?;
+        let node_features = Tensor::from_slice(&batch.node_features, (n, batch.node_dim), device)?
+            .to_dtype(dtype)?;
+        let edge_features = Tensor::from_slice(&batch.edge_features, (e, batch.edge_dim), device)?
+            .to_dtype(dtype)?;
+        Ok(Self {
+            node_features,
+            edge_features,
+            topology: Arc::new(topology),
+        })
+    }
+
+    pub fn num_nodes(&self) -> usize {
+        self.topology.num_nodes()
+    }
+
+    /// The same graph with each directed edge dropped independently with probability `p`
+    /// (training-mode edge dropout; nodes are kept).
+    pub fn drop_edges<R: Rng + ?Sized>(&self, p: f64, rng: &mut R) -> Result<Self> {
+        let (topology, kept) = self.topology.drop_edges(p, rng);
+        let kept = Tensor::from_vec(kept, topology.num_edges(), self.edge_features.device())?;
+        Ok(Self {
+            node_features: self.node_features.clone(),
+            edge_features: self.edge_features.index_select(&kept, 0)?,
+            topology: Arc::new(topology),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+
+    use super::*;
+
+    /// 3 nodes, edges 1→0, 2→0, and self-loops.
+    fn small() -> Topology {
+        Topology::new(
+            3,
+            vec![0, 1, 2, 1, 2],
+            vec![0, 0, 0, 1, 2],
+            vec![0, 3, 4, 5],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn source_index_lists_outgoing_edges() {
+        let t = small();
+        assert_eq!(t.src_offsets(), &[0, 1, 3, 5]);
+        assert_eq!(t.by_src(), &[0, 1, 3, 2, 4]);
+    }
+
+    #[test]
+    fn rejects_unsorted_or_out_of_range_edges() {
+        assert!(Topology::new(2, vec![0, 1], vec![1, 0], vec![0, 1, 2]).is_err());
+        assert!(Topology::new(2, vec![0, 5], vec![0, 1], vec![0, 1, 2]).is_err());
+        assert!(Topology::new(2, vec![0, 1], vec![0, 1], vec![0, 2]).is_err());
+        assert!(Topology::new(2, vec![0], vec![0, 1], vec![0, 1, 2]).is_err());
+    }
+
+    #[test]
+    fn dropout_keeps_order_and_offsets() {
+        let t = small();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let (none, kept) = t.drop_edges(0.0, &mut rng);
+        assert_eq!(kept, vec![0, 1, 2, 3, 4]);
+        assert_eq!(none.dst_offsets(), t.dst_offsets());
+        let (half, kept) = t.drop_edges(0.5, &mut rng);
+        let again = Topology::new(
+            3,
+            half.src().to_vec(),
+            half.dst().to_vec(),
+            half.dst_offsets().to_vec(),
+        );
+        assert!(again.is_ok());
+        assert!(kept.windows(2).all(|w| w[0] < w[1]));
+    }
+}

@@ -1,0 +1,34 @@
+//! The message passing network (MPN) of AMBER in candle: it maps a mesh graph (nodes =
+//! elements) to one predicted element size per node (spec §5), and the fused CPU custom ops that
+//! make it fast enough to train on CPUs.
+//!
+//! Input is an [`amber_graph::GraphBatch`]; this crate knows nothing of meshes, meshing, labels
+//! or the training loop around a step. Only the fused ops in `ops` touch raw tensor storage.
+//!
+//! ```
+//! use amber_mpn::{GraphInput, Mpn, MpnConfig};
+//! use candle_core::{DType, Device};
+//!
+//! let config = MpnConfig { latent_dim: 8, steps: 2, ..MpnConfig::poisson() };
+//! let (model, _vars) = Mpn::init(config, 0, DType::F32, &Device::Cpu)?;
+//! let batch = amber_mpn::synthetic::random_graph(10, 15, 4, 1, 0);
+//! let sizes = model.predict(&batch)?;
+//! assert_eq!(sizes.len(), 10);
+//! assert!(sizes.iter().all(|&h| h > 0.0)); // softplus output
+//! # Ok::<(), amber_mpn::MpnError>(())
+//! ```
+
+mod config;
+mod error;
+mod graph;
+mod kernels;
+mod model;
+mod ops;
+pub mod synthetic;
+mod train;
+
+pub use config::{MpnConfig, OutputTransform};
+pub use error::{MpnError, Result};
+pub use graph::{GraphInput, Topology};
+pub use model::Mpn;
+pub use train::{TrainConfig, Trainer, clip_grad_norm, grad_norm, mse};

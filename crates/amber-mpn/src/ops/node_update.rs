@@ -1,0 +1,282 @@
+//! The update function: `x ← LayerNorm(x + MLP_V([x, a]))` as one op, with the concatenation
+//! split into `x·W_x + a·W_a`.
+
+use candle_core::backend::BackendStorage;
+use candle_core::{CpuStorage, CustomOp3, Layout, Result, Shape, Tensor, bail};
+use rayon::prelude::*;
+
+use super::{Saved, SavedSlot, Scratch, cpu_slice, float_dtype, tensor_of, tensor_slice};
+use crate::kernels::{
+    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, matmul, packed_len, tail_backward,
+    tail_forward,
+};
+
+/// New node states (N×D) from node states `x` and aggregated messages `a` (both N×D) and the
+/// packed node MLP + LayerNorm parameters `theta` (input 2D).
+pub(crate) fn node_update(x: &Tensor, a: &Tensor, theta: &Tensor) -> Result<Tensor> {
+    let (x, a, theta) = (x.contiguous()?, a.contiguous()?, theta.contiguous()?);
+    let op = NodeUpdate {
+        rows: x.dim(0)?,
+        d: x.dim(1)?,
+        save: x.track_op() || a.track_op() || theta.track_op(),
+        saved: SavedSlot::default(),
+    };
+    x.apply_op3(&a, &theta, op)
+}
+
+struct NodeUpdate {
+    rows: usize,
+    d: usize,
+    save: bool,
+    saved: SavedSlot,
+}
+
+impl NodeUpdate {
+    fn check(&self, x: usize, a: usize, theta: usize) -> Result<()> {
+        let (n, d) = (self.rows, self.d);
+        if x != n * d || a != n * d || theta != packed_len(2 * d, d) {
+            bail!(
+                "node_update: got {x} node, {a} aggregate and {theta} parameter values for N={n}, D={d}"
+            );
+        }
+        Ok(())
+    }
+
+    fn forward<T: Real>(&self, x: &[T], a: &[T], theta: &[T]) -> Result<Vec<T>> {
+        self.check(x.len(), a.len(), theta.len())?;
+        let (n, d) = (self.rows, self.d);
+        let w = MlpWeights::unpack(theta, 2 * d, d);
+        let block = |x: &[T], a: &[T], st: TailState<'_, T>, out: &mut [T]| {
+            let rows = x.len() / d;
+            matmul(rows, d, d, x, false, w.w1_rows(0..d), false, st.h1, false);
+            matmul(
+                rows,
+                d,
+                d,
+                a,
+                false,
+                w.w1_rows(d..2 * d),
+                false,
+                st.h1,
+                true,
+            );
+            tail_forward(&w, x, st, out);
+        };
+        let zero = T::from_f64(0.0);
+        let chunk = BLOCK_ROWS * d;
+        let mut out = vec![zero; n * d];
+        if self.save {
+            let (mut h1, mut h2, mut mean, mut rstd) = (
+                vec![zero; n * d],
+                vec![zero; n * d],
+                vec![zero; n],
+                vec![zero; n],
+            );
+            (
+                out.par_chunks_mut(chunk),
+                x.par_chunks(chunk),
+                a.par_chunks(chunk),
+                h1.par_chunks_mut(chunk),
+                h2.par_chunks_mut(chunk),
+                mean.par_chunks_mut(BLOCK_ROWS),
+                rstd.par_chunks_mut(BLOCK_ROWS),
+            )
+                .into_par_iter()
+                .for_each(|(out, x, a, h1, h2, mean, rstd)| {
+                    block(x, a, TailState { h1, h2, mean, rstd }, out)
+                });
+            self.saved.put(Saved {
+                h1: T::to_cpu_storage_owned(h1),
+                h2: T::to_cpu_storage_owned(h2),
+                mean: T::to_cpu_storage_owned(mean),
+                rstd: T::to_cpu_storage_owned(rstd),
+            })?;
+        } else {
+            (
+                out.par_chunks_mut(chunk),
+                x.par_chunks(chunk),
+                a.par_chunks(chunk),
+            )
+                .into_par_iter()
+                .for_each_init(
+                    || Scratch::new(BLOCK_ROWS, d),
+                    |scratch, (out, x, a)| block(x, a, scratch.state(x.len() / d, d), out),
+                );
+        }
+        Ok(out)
+    }
+
+    fn backward<T: Real>(
+        &self,
+        x: &Tensor,
+        a: &Tensor,
+        theta: &Tensor,
+        grad: &Tensor,
+    ) -> Result<[Tensor; 3]> {
+        let grad = grad.contiguous()?;
+        let (xs, xl) = x.storage_and_layout();
+        let (as_, al) = a.storage_and_layout();
+        let (ts, tl) = theta.storage_and_layout();
+        let (gs, gl) = grad.storage_and_layout();
+        let (xv, av, tv, gv) = (
+            tensor_slice::<T>(&xs, xl)?,
+            tensor_slice::<T>(&as_, al)?,
+            tensor_slice::<T>(&ts, tl)?,
+            tensor_slice::<T>(&gs, gl)?,
+        );
+        self.check(xv.len(), av.len(), tv.len())?;
+        let saved = self.saved.take(self.name())?;
+        // As in the edge update, the saved activations are overwritten with gradients: h2 becomes
+        // d(x), h1 the first-layer pre-activation gradient.
+        let (mut h1, mut dx) = (
+            T::cpu_storage_data(saved.h1)?,
+            T::cpu_storage_data(saved.h2)?,
+        );
+        let (mean, rstd) = (saved.mean.as_slice::<T>()?, saved.rstd.as_slice::<T>()?);
+        let (n, d) = (self.rows, self.d);
+        if h1.len() != n * d || dx.len() != n * d {
+            bail!("node_update: saved activations do not match the input");
+        }
+        let w = MlpWeights::unpack(tv, 2 * d, d);
+        let zero = T::from_f64(0.0);
+        let chunk = BLOCK_ROWS * d;
+        let mut da = vec![zero; n * d];
+        let g = (
+            dx.par_chunks_mut(chunk),
+            da.par_chunks_mut(chunk),
+            h1.par_chunks_mut(chunk),
+            gv.par_chunks(chunk),
+            xv.par_chunks(chunk),
+            av.par_chunks(chunk),
+            mean.par_chunks(BLOCK_ROWS),
+            rstd.par_chunks(BLOCK_ROWS),
+        )
+            .into_par_iter()
+            .fold(
+                || (MlpGrads::zeros(2 * d, d), vec![zero; 2 * chunk]),
+                |(mut g, mut scratch), (dx, da, dpre1, gr, x, a, mean, rstd)| {
+                    let rows = x.len() / d;
+                    tail_backward(
+                        &w,
+                        gr,
+                        x,
+                        dpre1,
+                        dx,
+                        mean,
+                        rstd,
+                        &mut scratch[..2 * rows * d],
+                        &mut g,
+                    );
+                    matmul(rows, d, d, dpre1, false, w.w1_rows(0..d), true, dx, true);
+                    matmul(
+                        rows,
+                        d,
+                        d,
+                        dpre1,
+                        false,
+                        w.w1_rows(d..2 * d),
+                        true,
+                        da,
+                        false,
+                    );
+                    let (w1x, w1a) = g.w1.split_at_mut(d * d);
+                    matmul(d, rows, d, x, true, dpre1, false, w1x, true);
+                    matmul(d, rows, d, a, true, dpre1, false, w1a, true);
+                    (g, scratch)
+                },
+            )
+            .map(|(g, _)| g)
+            .reduce(|| MlpGrads::zeros(2 * d, d), MlpGrads::merge);
+        Ok([
+            tensor_of(dx, (n, d), x)?,
+            tensor_of(da, (n, d), a)?,
+            Tensor::from_vec(g.pack(2 * d, d), theta.shape(), theta.device())?,
+        ])
+    }
+}
+
+impl CustomOp3 for NodeUpdate {
+    fn name(&self) -> &'static str {
+        "amber-node-update"
+    }
+
+    fn cpu_fwd(
+        &self,
+        s1: &CpuStorage,
+        l1: &Layout,
+        s2: &CpuStorage,
+        l2: &Layout,
+        s3: &CpuStorage,
+        l3: &Layout,
+    ) -> Result<(CpuStorage, Shape)> {
+        let shape = Shape::from((self.rows, self.d));
+        let storage = match float_dtype(self.name(), &[s1.dtype(), s2.dtype(), s3.dtype()])? {
+            candle_core::DType::F32 => CpuStorage::F32(self.forward::<f32>(
+                cpu_slice(s1, l1)?,
+                cpu_slice(s2, l2)?,
+                cpu_slice(s3, l3)?,
+            )?),
+            _ => CpuStorage::F64(self.forward::<f64>(
+                cpu_slice(s1, l1)?,
+                cpu_slice(s2, l2)?,
+                cpu_slice(s3, l3)?,
+            )?),
+        };
+        Ok((storage, shape))
+    }
+
+    fn bwd(
+        &self,
+        x: &Tensor,
+        a: &Tensor,
+        theta: &Tensor,
+        _res: &Tensor,
+        grad: &Tensor,
+    ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let [dx, da, dtheta] = match float_dtype(
+            self.name(),
+            &[x.dtype(), a.dtype(), theta.dtype(), grad.dtype()],
+        )? {
+            candle_core::DType::F32 => self.backward::<f32>(x, a, theta, grad)?,
+            _ => self.backward::<f64>(x, a, theta, grad)?,
+        };
+        Ok((Some(dx), Some(da), Some(dtheta)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ops::gradcheck::*;
+
+    fn fused(t: &[Tensor]) -> Result<Tensor> {
+        probe_loss(&node_update(&t[0], &t[1], &t[2])?, 7)
+    }
+
+    fn composed(t: &[Tensor]) -> Result<Tensor> {
+        probe_loss(
+            &composed_residual_mlp(&Tensor::cat(&[&t[0], &t[1]], 1)?, &t[0], &t[2])?,
+            7,
+        )
+    }
+
+    #[test]
+    fn gradients_match_finite_differences() {
+        let t = [random((5, 3), 1), random((5, 3), 2), random_theta(6, 3, 3)];
+        check_finite_differences(&t, &fused);
+    }
+
+    #[test]
+    fn matches_the_candle_composition_across_blocks() {
+        for n in [5, 600] {
+            let t = [random((n, 4), 1), random((n, 4), 2), random_theta(8, 4, 3)];
+            assert!(
+                (fused(&t).unwrap().to_scalar::<f64>().unwrap()
+                    - composed(&t).unwrap().to_scalar::<f64>().unwrap())
+                .abs()
+                    < 1e-9
+            );
+            assert_close(&autograd(&t, &fused), &autograd(&t, &composed), 1e-10);
+        }
+    }
+}

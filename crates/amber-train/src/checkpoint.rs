@@ -1,0 +1,233 @@
+//! Checkpoint files of a training run, written so that a killed run resumes exactly.
+//!
+//! Layout under the run's output directory:
+//!
+//! ```text
+//! checkpoints/latest                      name of the newest complete checkpoint
+//! checkpoints/step-00001000/              one checkpoint: model.safetensors + model.json,
+//!                                         predictor.json, optimiser.safetensors, state.json
+//! checkpoints/entries/0000000042.safetensors   buffer entry 42 (mesh, input columns, labels)
+//! ```
+//!
+//! A checkpoint directory is written under a temporary name and renamed into place, then
+//! `latest` is replaced atomically; only then are older checkpoints and entries no longer in the
+//! buffer deleted. Buffer entries never change after creation (only their use counts, which live
+//! in `state.json`), so each is written once.
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+
+use amber_graph::FeatureSet;
+use amber_mesh::Mesh;
+use candle_core::{Device, Tensor};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, TrainError, io_error};
+use crate::model::{tmp_path, write_atomic};
+use crate::{BufferEntry, Column, MeshState, Sample, TargetTransform, TrainingConfig};
+
+/// Sub-directory of the output directory holding the checkpoints.
+pub const CHECKPOINTS_DIR: &str = "checkpoints";
+const LATEST_FILE: &str = "latest";
+const ENTRIES_DIR: &str = "entries";
+pub(crate) const STATE_FILE: &str = "state.json";
+pub(crate) const OPTIMISER_FILE: &str = "optimiser.safetensors";
+
+/// The exact state of a ChaCha generator.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub(crate) struct RngState {
+    seed: [u8; 32],
+    stream: u64,
+    /// The 128-bit word position, as a decimal string (JSON numbers are not 128-bit).
+    word_pos: String,
+}
+
+impl RngState {
+    pub(crate) fn of(rng: &ChaCha8Rng) -> Self {
+        Self { seed: rng.get_seed(), stream: rng.get_stream(), word_pos: rng.get_word_pos().to_string() }
+    }
+
+    pub(crate) fn restore(&self, path: &Path) -> Result<ChaCha8Rng> {
+        use rand::SeedableRng;
+        let word_pos: u128 = self.word_pos.parse().map_err(|_| TrainError::Checkpoint {
+            path: path.into(),
+            message: format!("invalid generator word position `{}`", self.word_pos),
+        })?;
+        let mut rng = ChaCha8Rng::from_seed(self.seed);
+        rng.set_stream(self.stream);
+        rng.set_word_pos(word_pos);
+        Ok(rng)
+    }
+}
+
+/// The bookkeeping of one buffer entry (its payload is in `entries/`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub(crate) struct EntryRecord {
+    pub id: u64,
+    pub problem: usize,
+    pub depth: usize,
+    pub sampled_count: u64,
+}
+
+impl EntryRecord {
+    pub(crate) fn of<const D: usize>(e: &BufferEntry<D>) -> Self {
+        Self { id: e.id, problem: e.problem, depth: e.depth, sampled_count: e.sampled_count }
+    }
+}
+
+/// What identifies a training problem well enough to refuse resuming with other problems.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub(crate) struct ProblemFingerprint {
+    pub initial_elements: usize,
+    pub expert_elements: usize,
+    pub expert_volume: f64,
+}
+
+/// Counts of buffer additions by outcome.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AdditionCounts {
+    pub added: u64,
+    pub over_budget: u64,
+    pub failed: u64,
+}
+
+/// `state.json`: everything of a run that is neither the network, the optimiser moments, the
+/// predictor nor an entry payload.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub(crate) struct TrainingState {
+    pub config: TrainingConfig,
+    /// Gradient steps completed.
+    pub step: u64,
+    pub optimiser_steps: u64,
+    pub dropout_rng: RngState,
+    pub buffer_rng: RngState,
+    pub problems: Vec<ProblemFingerprint>,
+    pub next_entry_id: u64,
+    pub protected: Vec<EntryRecord>,
+    pub generated: Vec<EntryRecord>,
+    pub additions: AdditionCounts,
+}
+
+/// The directory of the newest complete checkpoint under `out_dir`, if any.
+pub fn latest_checkpoint(out_dir: &Path) -> Result<Option<PathBuf>> {
+    let root = out_dir.join(CHECKPOINTS_DIR);
+    let latest = root.join(LATEST_FILE);
+    match std::fs::read_to_string(&latest) {
+        Ok(name) => Ok(Some(root.join(name.trim()))),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(io_error(latest)(e)),
+    }
+}
+
+/// Writes a checkpoint named after `step`: first every entry payload not yet on disk, then the
+/// files `write` puts into a fresh directory, which is renamed into place and made `latest`;
+/// finally older checkpoints and payloads of entries that left the buffer are removed.
+pub(crate) fn commit<'e, const D: usize>(
+    out_dir: &Path,
+    step: u64,
+    entries: impl Iterator<Item = &'e BufferEntry<D>>,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<PathBuf> {
+    let root = out_dir.join(CHECKPOINTS_DIR);
+    let entries_dir = root.join(ENTRIES_DIR);
+    std::fs::create_dir_all(&entries_dir).map_err(io_error(&entries_dir))?;
+    let mut live = HashSet::new();
+    for entry in entries {
+        let path = entry_path(&entries_dir, entry.id);
+        if !path.exists() {
+            save_entry(&path, &entry.sample)?;
+        }
+        live.insert(path);
+    }
+    let name = format!("step-{step:08}");
+    let tmp = root.join(format!(".tmp-{name}"));
+    remove_dir_if_present(&tmp)?;
+    std::fs::create_dir_all(&tmp).map_err(io_error(&tmp))?;
+    write(&tmp)?;
+    let dir = root.join(&name);
+    remove_dir_if_present(&dir)?;
+    std::fs::rename(&tmp, &dir).map_err(io_error(&dir))?;
+    write_atomic(&root.join(LATEST_FILE), name.as_bytes())?;
+
+    for item in std::fs::read_dir(&root).map_err(io_error(&root))? {
+        let path = item.map_err(io_error(&root))?.path();
+        let file = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        if file.starts_with("step-") && file != name {
+            remove_dir_if_present(&path)?;
+        }
+    }
+    for item in std::fs::read_dir(&entries_dir).map_err(io_error(&entries_dir))? {
+        let path = item.map_err(io_error(&entries_dir))?.path();
+        if !live.contains(&path) {
+            std::fs::remove_file(&path).map_err(io_error(&path))?;
+        }
+    }
+    Ok(dir)
+}
+
+fn remove_dir_if_present(dir: &Path) -> Result<()> {
+    match std::fs::remove_dir_all(dir) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(io_error(dir)(e)),
+        _ => Ok(()),
+    }
+}
+
+fn entry_path(entries_dir: &Path, id: u64) -> PathBuf {
+    entries_dir.join(format!("{id:010}.safetensors"))
+}
+
+/// Writes one entry's mesh, input columns and labels (safetensors: `vertices`, `cells`,
+/// `labels`, `column.<name>`).
+fn save_entry<const D: usize>(path: &Path, sample: &Sample<D>) -> Result<()> {
+    let (mesh, cpu) = (&sample.state.mesh, &Device::Cpu);
+    let vertices: Vec<f64> = mesh.vertices().iter().flatten().copied().collect();
+    let mut tensors = HashMap::from([
+        ("vertices".to_string(), Tensor::from_vec(vertices, (mesh.num_vertices(), D), cpu)?),
+        ("cells".to_string(), Tensor::from_vec(mesh.cells().to_vec(), (mesh.num_elements(), D + 1), cpu)?),
+        ("labels".to_string(), Tensor::from_slice(&sample.labels, sample.labels.len(), cpu)?),
+    ]);
+    for c in &sample.state.columns {
+        tensors.insert(format!("column.{}", c.name), Tensor::from_slice(&c.values, c.values.len(), cpu)?);
+    }
+    let tmp = tmp_path(path);
+    candle_core::safetensors::save(&tensors, &tmp)
+        .map_err(|e| TrainError::Checkpoint { path: tmp.clone(), message: e.to_string() })?;
+    std::fs::rename(&tmp, path).map_err(io_error(path))
+}
+
+/// Reads the entry `record` from the checkpoint `dir` and rebuilds its graph and targets.
+pub(crate) fn load_entry<const D: usize>(
+    dir: &Path,
+    record: &EntryRecord,
+    features: &FeatureSet,
+    target: &TargetTransform,
+) -> Result<BufferEntry<D>> {
+    let path = entry_path(&dir.parent().unwrap_or(dir).join(ENTRIES_DIR), record.id);
+    let fail = |message: String| TrainError::Checkpoint { path: path.clone(), message };
+    let mut tensors = candle_core::safetensors::load(&path, &Device::Cpu).map_err(|e| fail(e.to_string()))?;
+    let mut take = |name: &str| tensors.remove(name).ok_or_else(|| fail(format!("missing tensor `{name}`")));
+    let vertices: Vec<f64> = take("vertices")?.flatten_all()?.to_vec1()?;
+    let cells: Vec<u32> = take("cells")?.flatten_all()?.to_vec1()?;
+    let labels: Vec<f64> = take("labels")?.to_vec1()?;
+    let vertices = vertices.chunks_exact(D).map(|v| std::array::from_fn(|k| v[k])).collect();
+    let mesh = Mesh::new(vertices, cells).map_err(|e| fail(e.to_string()))?;
+    let mut columns = Vec::new();
+    for (name, t) in tensors {
+        let name = name.strip_prefix("column.").ok_or_else(|| fail(format!("unexpected tensor `{name}`")))?;
+        columns.push(Column { name: name.to_string(), values: t.to_vec1()? });
+    }
+    columns.sort_by(|a, b| a.name.cmp(&b.name));
+    let state = MeshState::from_columns(features, mesh, columns).map_err(|e| fail(e.to_string()))?;
+    if labels.len() != state.mesh.num_elements() {
+        return Err(fail(format!("{} labels for {} elements", labels.len(), state.mesh.num_elements())));
+    }
+    let targets = target.raw_targets(&labels, &state.mesh.sizes());
+    Ok(BufferEntry {
+        id: record.id,
+        problem: record.problem,
+        depth: record.depth,
+        sampled_count: record.sampled_count,
+        sample: Sample { state, labels, targets },
+    })
+}

@@ -1,0 +1,58 @@
+//! Errors of the training and inference loops.
+
+use std::path::PathBuf;
+
+use amber_graph::GraphError;
+use amber_mpn::MpnError;
+
+use crate::ProblemError;
+
+/// Everything that can go wrong training AMBER or rolling it out.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum TrainError {
+    /// The configuration is inconsistent; the message names the field.
+    #[error("invalid training configuration: {0}")]
+    InvalidConfig(String),
+    /// Training needs at least one problem.
+    #[error("no training problems")]
+    NoProblems,
+    /// One problem's step failed (FEM, graph, labels, metrics, or a broken mesh generator).
+    #[error("problem {problem}: {source}")]
+    Problem { problem: usize, source: ProblemError },
+    /// Batching or normalising graphs failed.
+    #[error("graph batch: {0}")]
+    Graph(#[from] GraphError),
+    /// The network failed (shapes, candle, checkpoint files).
+    #[error("network: {0}")]
+    Network(#[from] MpnError),
+    /// A file or directory could not be read or written.
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    /// A file is not valid JSON of the expected shape.
+    #[error("{path}: {source}")]
+    Json { path: PathBuf, source: serde_json::Error },
+    /// A checkpoint is missing a piece or does not fit the run it should resume.
+    #[error("checkpoint {path}: {message}")]
+    Checkpoint { path: PathBuf, message: String },
+}
+
+impl From<candle_core::Error> for TrainError {
+    fn from(e: candle_core::Error) -> Self {
+        TrainError::Network(MpnError::Candle(e))
+    }
+}
+
+/// `Result` with [`TrainError`].
+pub type Result<T, E = TrainError> = std::result::Result<T, E>;
+
+/// Tags a problem's error with its index.
+pub(crate) fn in_problem<E: Into<ProblemError>>(problem: usize) -> impl FnOnce(E) -> TrainError {
+    move |e| TrainError::Problem { problem, source: e.into() }
+}
+
+/// Wraps an I/O error with its path.
+pub(crate) fn io_error(path: impl Into<PathBuf>) -> impl FnOnce(std::io::Error) -> TrainError {
+    let path = path.into();
+    move |source| TrainError::Io { path, source }
+}

@@ -1,0 +1,286 @@
+//! Inference (spec §6, reference notes §6.5): T generation steps from M⁰ (predict → clip at
+//! h_min → budget guard → generate → features), every intermediate mesh compared with the expert,
+//! normalised by the initial mesh M⁰ and the reconstruction M̂ (spec §7).
+
+use amber_mesh::Mesh;
+use amber_metrics::{compare_meshes, normalised_dcd};
+use amber_mpn::Mpn;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, in_problem};
+use crate::{MeshLimits, MeshState, Predictor, Problem, ProblemError, StepOutcome, generation_step};
+
+/// Predictions are made in batches of at most this many nodes (a rollout over many large
+/// problems would not fit one batch in memory).
+const PREDICTION_NODES: usize = 200_000;
+
+/// The per-problem constants of the normalised DCD: the reconstruction M̂ (the generator run
+/// with the expert's own sizing field, clipped at h_min) and the DCDs of M⁰ and M̂ to M*.
+#[derive(Clone, Debug)]
+pub struct Reference<const D: usize> {
+    pub reconstruction: Mesh<D>,
+    /// d(M⁰, M*).
+    pub initial_dcd: f64,
+    /// d(M̂, M*).
+    pub reconstruction_dcd: f64,
+}
+
+impl<const D: usize> Reference<D> {
+    /// Meshes M̂ and measures d(M⁰, M*) and d(M̂, M*).
+    pub fn new<P: Problem<D> + ?Sized>(problem: &P, limits: &MeshLimits) -> Result<Self, ProblemError> {
+        let expert = problem.expert_mesh();
+        let sizes = expert.sizes().into_iter().map(|h| h.max(limits.min_size)).collect();
+        let reconstruction = problem.remesh(expert, sizes, limits.generator_cap().max(4 * expert.num_elements()))?;
+        let initial_dcd = compare_meshes(problem.initial_mesh(), expert)?.midpoints.dcd;
+        let reconstruction_dcd = compare_meshes(&reconstruction, expert)?.midpoints.dcd;
+        Ok(Self { reconstruction, initial_dcd, reconstruction_dcd })
+    }
+
+    /// The references of many problems, in parallel.
+    pub fn for_problems<P: Problem<D>>(problems: &[P], limits: &MeshLimits) -> Result<Vec<Self>> {
+        problems.par_iter().enumerate().map(|(i, p)| Self::new(p, limits).map_err(in_problem(i))).collect()
+    }
+}
+
+/// What happened at one step of a rollout.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum StepStatus {
+    /// A new mesh was generated.
+    Meshed,
+    /// The estimated element count exceeded the budget; the previous mesh is kept.
+    OverBudget { estimated_elements: f64 },
+    /// The generator failed; the previous mesh is kept.
+    Failed { reason: String },
+    /// An earlier step failed: the rollout stopped and its last mesh is carried forward (the
+    /// prediction from the same mesh would be the same).
+    Stopped,
+}
+
+/// The metrics of one mesh against its expert (spec §7).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MeshMetrics {
+    /// Raw DCD d(M, M*).
+    pub dcd: f64,
+    /// (d(M) − d(M̂)) / (d(M⁰) − d(M̂)): 0 as good as M̂, 1 no better than M⁰.
+    pub normalised_dcd: f64,
+    /// Chamfer distance of the midpoints.
+    pub chamfer: f64,
+    /// Symmetric volume difference (summed).
+    pub volume_difference: f64,
+    /// Elements of the mesh.
+    pub elements: usize,
+}
+
+/// One step of a rollout: the mesh after it and its metrics.
+#[derive(Clone, Debug)]
+pub struct RolloutStep<const D: usize> {
+    pub status: StepStatus,
+    pub mesh: Mesh<D>,
+    pub metrics: MeshMetrics,
+}
+
+/// A rollout of one problem: M⁰'s metrics and T steps.
+#[derive(Clone, Debug)]
+pub struct Rollout<const D: usize> {
+    pub initial: MeshMetrics,
+    pub steps: Vec<RolloutStep<D>>,
+    pub initial_dcd: f64,
+    pub reconstruction_dcd: f64,
+}
+
+fn metrics<const D: usize>(mesh: &Mesh<D>, expert: &Mesh<D>, reference: &Reference<D>) -> Result<MeshMetrics, ProblemError> {
+    let c = compare_meshes(mesh, expert)?;
+    Ok(MeshMetrics {
+        dcd: c.midpoints.dcd,
+        normalised_dcd: normalised_dcd(c.midpoints.dcd, reference.initial_dcd, reference.reconstruction_dcd)?,
+        chamfer: c.midpoints.chamfer,
+        volume_difference: c.volume.summed,
+        elements: mesh.num_elements(),
+    })
+}
+
+/// Rolls out `steps` generation steps on every problem in lockstep (one batched prediction per
+/// step, meshing in parallel). `references[i]` belongs to `problems[i]`.
+pub fn rollouts<const D: usize, P: Problem<D>>(
+    network: &Mpn,
+    predictor: &Predictor,
+    problems: &[P],
+    references: &[Reference<D>],
+    steps: usize,
+) -> Result<Vec<Rollout<D>>> {
+    assert_eq!(problems.len(), references.len(), "one reference per problem");
+    let mut states: Vec<MeshState<D>> = problems
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| MeshState::new(p, p.initial_mesh().clone()).map_err(in_problem(i)))
+        .collect::<Result<_>>()?;
+    let mut out: Vec<Rollout<D>> = problems
+        .par_iter()
+        .zip(references)
+        .enumerate()
+        .map(|(i, (p, r))| {
+            Ok(Rollout {
+                initial: metrics(p.initial_mesh(), p.expert_mesh(), r).map_err(in_problem(i))?,
+                steps: Vec::with_capacity(steps),
+                initial_dcd: r.initial_dcd,
+                reconstruction_dcd: r.reconstruction_dcd,
+            })
+        })
+        .collect::<Result<_>>()?;
+    let mut active = vec![true; problems.len()];
+    for _ in 0..steps {
+        let running: Vec<usize> = (0..problems.len()).filter(|&i| active[i]).collect();
+        let mut sizes = Vec::with_capacity(running.len());
+        for chunk in node_chunks(&running, |i| states[i].graph.num_nodes()) {
+            let batch: Vec<&MeshState<D>> = chunk.iter().map(|&i| &states[i]).collect();
+            sizes.extend(predictor.predict(network, &batch)?);
+        }
+        let mut sizes: Vec<Option<Vec<f64>>> = sizes.into_iter().map(Some).collect();
+        let mut per_problem: Vec<Option<Vec<f64>>> = vec![None; problems.len()];
+        for (&i, s) in running.iter().zip(&mut sizes) {
+            per_problem[i] = s.take();
+        }
+        let advanced: Vec<(StepStatus, Option<MeshState<D>>)> = states
+            .par_iter()
+            .zip(per_problem)
+            .enumerate()
+            .map(|(i, (state, sizes))| {
+                let Some(sizes) = sizes else { return Ok((StepStatus::Stopped, None)) };
+                Ok(match generation_step(&problems[i], &state.mesh, sizes, &predictor.limits) {
+                    StepOutcome::Meshed(mesh) => {
+                        (StepStatus::Meshed, Some(MeshState::new(&problems[i], mesh).map_err(in_problem(i))?))
+                    }
+                    StepOutcome::OverBudget { estimated_elements } => (StepStatus::OverBudget { estimated_elements }, None),
+                    StepOutcome::Failed { reason } => (StepStatus::Failed { reason }, None),
+                })
+            })
+            .collect::<Result<_>>()?;
+        for (i, (status, next)) in advanced.into_iter().enumerate() {
+            match next {
+                Some(next) => states[i] = next,
+                None => active[i] = false,
+            }
+            let placeholder = out[i].initial;
+            out[i].steps.push(RolloutStep { status, mesh: states[i].mesh.clone(), metrics: placeholder });
+        }
+        out.par_iter_mut().zip(problems).zip(references).enumerate().try_for_each(|(i, ((rollout, p), r))| {
+            let previous = rollout.steps.iter().rev().nth(1).map_or(rollout.initial, |s| s.metrics);
+            let step = rollout.steps.last_mut().expect("pushed above");
+            step.metrics = match step.status {
+                StepStatus::Meshed => metrics(&step.mesh, p.expert_mesh(), r).map_err(in_problem(i))?,
+                // The mesh was carried forward, and so are its metrics.
+                _ => previous,
+            };
+            Ok::<_, crate::TrainError>(())
+        })?;
+    }
+    Ok(out)
+}
+
+/// Splits `items` into consecutive chunks of at most [`PREDICTION_NODES`] nodes (a larger single
+/// item forms a chunk alone).
+fn node_chunks(items: &[usize], nodes: impl Fn(usize) -> usize) -> Vec<Vec<usize>> {
+    let mut chunks: Vec<Vec<usize>> = Vec::new();
+    let mut total = 0;
+    for &i in items {
+        let n = nodes(i);
+        if chunks.is_empty() || total + n > PREDICTION_NODES {
+            chunks.push(Vec::new());
+            total = 0;
+        }
+        total += n;
+        chunks.last_mut().expect("pushed").push(i);
+    }
+    chunks
+}
+
+/// Means over problems at one generation step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepSummary {
+    /// Mean normalised DCD over all problems (failed steps carry the last mesh forward, as the
+    /// later version does).
+    pub normalised_dcd: f64,
+    /// Mean normalised DCD over the problems whose rollout has not failed so far (the workshop
+    /// code's protocol, biased towards easy problems); `None` if every rollout failed.
+    pub normalised_dcd_successful: Option<f64>,
+    /// Mean raw DCD (carried forward).
+    pub dcd: f64,
+    /// Mean element count (carried forward).
+    pub elements: f64,
+    /// Problems whose rollout has failed at this step or before.
+    pub failed: usize,
+}
+
+/// The summary of rollouts over a set of problems.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EvaluationSummary {
+    pub problems: usize,
+    /// Mean d(M⁰, M*).
+    pub initial_dcd: f64,
+    /// Mean d(M̂, M*).
+    pub reconstruction_dcd: f64,
+    /// Mean element count of the experts.
+    pub expert_elements: f64,
+    /// One entry per generation step.
+    pub steps: Vec<StepSummary>,
+}
+
+impl EvaluationSummary {
+    /// Summarises rollouts of `problems` (same order).
+    pub fn new<const D: usize, P: Problem<D>>(problems: &[P], rollouts: &[Rollout<D>]) -> Self {
+        let n = rollouts.len().max(1) as f64;
+        let mean = |f: &dyn Fn(&Rollout<D>) -> f64| rollouts.iter().map(f).sum::<f64>() / n;
+        let steps = rollouts.first().map_or(0, |r| r.steps.len());
+        let steps = (0..steps)
+            .map(|t| {
+                let ok: Vec<f64> = rollouts
+                    .iter()
+                    .filter(|r| r.steps[..=t].iter().all(|s| s.status == StepStatus::Meshed))
+                    .map(|r| r.steps[t].metrics.normalised_dcd)
+                    .collect();
+                StepSummary {
+                    normalised_dcd: mean(&|r| r.steps[t].metrics.normalised_dcd),
+                    normalised_dcd_successful: (!ok.is_empty()).then(|| ok.iter().sum::<f64>() / ok.len() as f64),
+                    dcd: mean(&|r| r.steps[t].metrics.dcd),
+                    elements: mean(&|r| r.steps[t].metrics.elements as f64),
+                    failed: rollouts.len() - ok.len(),
+                }
+            })
+            .collect();
+        Self {
+            problems: rollouts.len(),
+            initial_dcd: mean(&|r| r.initial_dcd),
+            reconstruction_dcd: mean(&|r| r.reconstruction_dcd),
+            expert_elements: problems.iter().map(|p| p.expert_mesh().num_elements() as f64).sum::<f64>() / n,
+            steps,
+        }
+    }
+
+    /// The mean normalised DCD after the last step (the headline number).
+    pub fn final_normalised_dcd(&self) -> Option<f64> {
+        self.steps.last().map(|s| s.normalised_dcd)
+    }
+}
+
+/// A fixed set of evaluation problems with their references, built once and rolled out as often
+/// as needed (validation during training, the final test).
+pub struct Evaluation<'p, const D: usize, P: Problem<D>> {
+    pub problems: &'p [P],
+    pub references: Vec<Reference<D>>,
+}
+
+impl<'p, const D: usize, P: Problem<D>> Evaluation<'p, D, P> {
+    /// Builds the references of `problems` with the training run's `limits`.
+    pub fn new(problems: &'p [P], limits: &MeshLimits) -> Result<Self> {
+        Ok(Self { problems, references: Reference::for_problems(problems, limits)? })
+    }
+
+    /// Rolls out `steps` steps on every problem and summarises.
+    pub fn run(&self, network: &Mpn, predictor: &Predictor, steps: usize) -> Result<(Vec<Rollout<D>>, EvaluationSummary)> {
+        let rollouts = rollouts(network, predictor, self.problems, &self.references, steps)?;
+        let summary = EvaluationSummary::new(self.problems, &rollouts);
+        Ok((rollouts, summary))
+    }
+}

@@ -1,0 +1,38 @@
+//! AMBER's training and inference loops, above every other layer: the task abstraction
+//! ([`Problem`], implemented for the Poisson task), the replay buffer with least-used batching
+//! and stratified additions, running input and label normalisation, the training loop with
+//! checkpoints that resume exactly and a JSON-lines log, and rollouts of a trained model with
+//! their metrics against the expert.
+//!
+//! Configuration is one typed struct ([`TrainingConfig`]) with named profiles. The crate never
+//! prints: progress goes through [`TrainingObserver`]; argument parsing and plotting belong to the
+//! binaries.
+//!
+//! Determinism: a run is a function of its configuration (seed included) and problems. With one
+//! rayon thread it is bit-for-bit reproducible, across resumes too; with more threads the
+//! network's parallel gradient reductions sum in a scheduling-dependent order, so runs agree only
+//! to rounding at first and then drift apart.
+
+mod buffer;
+mod checkpoint;
+mod config;
+mod error;
+mod inference;
+mod model;
+mod optim;
+mod target;
+mod task;
+mod train;
+
+pub use buffer::{BufferEntry, ReplayBuffer, Sample};
+pub use checkpoint::{AdditionCounts, CHECKPOINTS_DIR, latest_checkpoint};
+pub use config::{DataConfig, LrSchedule, NetworkConfig, Objective, Profile, SourceSelection, TrainingConfig};
+pub use error::{Result, TrainError};
+pub use inference::{
+    Evaluation, EvaluationSummary, MeshMetrics, Reference, Rollout, RolloutStep, StepStatus, StepSummary, rollouts,
+};
+pub use model::{AmberModel, Predictor, WEIGHTS_FILE};
+pub use optim::Adam;
+pub use target::{TargetTransform, softplus, softplus_inverse};
+pub use task::{Column, MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step, labels};
+pub use train::{Addition, CONFIG_FILE, LOG_FILE, MODEL_DIR, StepReport, Training, TrainingObserver};

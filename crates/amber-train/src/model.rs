@@ -1,0 +1,104 @@
+//! A trained AMBER model: the network plus everything needed to turn meshes into sizing fields
+//! (input normaliser, target transform, clip and budget), saved and loaded as one directory.
+
+use std::path::Path;
+
+use amber_graph::{FeatureNormaliser, FeatureSet, GraphBatch};
+use amber_mpn::{GraphInput, Mpn};
+use candle_core::{DType, Device};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, TrainError, io_error};
+use crate::{MeshLimits, MeshState, TargetTransform};
+
+/// File of the network weights inside a model directory (its config is `model.json`).
+pub const WEIGHTS_FILE: &str = "model.safetensors";
+/// File of everything but the network inside a model directory.
+pub(crate) const PREDICTOR_FILE: &str = "predictor.json";
+
+/// Everything of a model except the network weights.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Predictor {
+    /// The graphs' features (must match the task the model is applied to).
+    pub features: FeatureSet,
+    /// Running input normalisation; `None`: inputs are fed raw (the ablation).
+    pub normaliser: Option<FeatureNormaliser>,
+    pub target: TargetTransform,
+    pub limits: MeshLimits,
+}
+
+impl Predictor {
+    /// Predicted element sizes for each state, from one batched forward pass of `network` in
+    /// evaluation mode (no dropout, no autograd graph).
+    pub fn predict<const D: usize>(&self, network: &Mpn, states: &[&MeshState<D>]) -> Result<Vec<Vec<f64>>> {
+        if states.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mut batch = GraphBatch::from_graphs(states.iter().map(|s| &s.graph))
+            ?;
+        if let Some(normaliser) = &self.normaliser {
+            normaliser.normalise(&mut batch)?;
+        }
+        let input = GraphInput::from_batch(&batch, network.dtype(), &Device::Cpu)?;
+        let z: Vec<f32> = network.for_inference().forward(&input)?.to_dtype(DType::F32)?.to_vec1()?;
+        Ok(states
+            .iter()
+            .zip(batch.node_offsets.windows(2))
+            .map(|(state, range)| self.target.sizes(&z[range[0] as usize..range[1] as usize], &state.mesh.sizes()))
+            .collect())
+    }
+}
+
+/// A trained model ready for inference.
+pub struct AmberModel {
+    pub network: Mpn,
+    pub predictor: Predictor,
+}
+
+impl AmberModel {
+    /// Writes `model.safetensors`, `model.json` and `predictor.json` into `dir` (created if
+    /// missing). `varmap` holds the network's variables.
+    pub fn save(network: &Mpn, varmap: &candle_nn::VarMap, predictor: &Predictor, dir: &Path) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(io_error(dir))?;
+        network.save(varmap, &dir.join(WEIGHTS_FILE))?;
+        write_json(&dir.join(PREDICTOR_FILE), predictor)
+    }
+
+    /// Loads a model directory written by [`Self::save`] (a training checkpoint directory is
+    /// one too) for inference.
+    pub fn load(dir: &Path) -> Result<Self> {
+        let network = Mpn::load(&dir.join(WEIGHTS_FILE), DType::F32, &Device::Cpu)?;
+        let predictor = read_json(&dir.join(PREDICTOR_FILE))?;
+        Ok(Self { network, predictor })
+    }
+
+    /// Predicted element sizes for each state.
+    pub fn predict<const D: usize>(&self, states: &[&MeshState<D>]) -> Result<Vec<Vec<f64>>> {
+        self.predictor.predict(&self.network, states)
+    }
+}
+
+/// Writes `value` as pretty JSON, atomically (temporary file, then rename).
+pub(crate) fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
+    let json = serde_json::to_vec_pretty(value).map_err(|source| TrainError::Json { path: path.into(), source })?;
+    write_atomic(path, &json)
+}
+
+/// Reads JSON of type `T`.
+pub(crate) fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T> {
+    let bytes = std::fs::read(path).map_err(io_error(path))?;
+    serde_json::from_slice(&bytes).map_err(|source| TrainError::Json { path: path.into(), source })
+}
+
+/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = tmp_path(path);
+    std::fs::write(&tmp, bytes).map_err(io_error(&tmp))?;
+    std::fs::rename(&tmp, path).map_err(io_error(path))
+}
+
+/// `dir/.name.tmp` for `dir/name`.
+pub(crate) fn tmp_path(path: &Path) -> std::path::PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.tmp"))
+}

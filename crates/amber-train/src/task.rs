@@ -1,0 +1,197 @@
+//! What the loops need to know about a learning task: a [`Problem`] has an initial and an expert
+//! mesh, computes its per-element input columns on any mesh of its domain, and re-meshes its
+//! domain from a per-element sizing field. The Poisson task is implemented; the Console (3D)
+//! task plugs in by implementing [`Problem<3>`].
+
+use amber_fem::{ExpertHeuristic, FemError, P1Space, Quadrature, element_stats};
+use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, project_expert_sizing};
+use amber_mesh::Mesh;
+use amber_meshgen::{Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, estimated_element_count, generate_2d, quantile};
+use amber_metrics::MetricsError;
+use amber_tasks::poisson::PoissonProblem;
+use serde::{Deserialize, Serialize};
+
+/// Why one problem's step failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ProblemError {
+    /// The mesh generator failed.
+    #[error("meshing: {0}")]
+    Meshing(#[from] MeshgenError),
+    /// The FEM solve behind the features failed.
+    #[error("FEM: {0}")]
+    Fem(#[from] FemError),
+    /// Graph building or label projection failed.
+    #[error("graph: {0}")]
+    Graph(#[from] GraphError),
+    /// A metric was undefined.
+    #[error("metrics: {0}")]
+    Metrics(#[from] MetricsError),
+}
+
+/// A named per-element input column (e.g. the mean of the FEM solution over each element).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Column {
+    pub name: String,
+    /// One value per element.
+    pub values: Vec<f64>,
+}
+
+/// One problem of a learning task in `D` dimensions.
+pub trait Problem<const D: usize>: Sync {
+    /// The node and edge features of this task's graphs (the same for all its problems).
+    fn feature_set(&self) -> FeatureSet;
+    /// M⁰, the start of every rollout.
+    fn initial_mesh(&self) -> &Mesh<D>;
+    /// M*, the expert's mesh the labels come from.
+    fn expert_mesh(&self) -> &Mesh<D>;
+    /// The per-element columns the feature set names, on `mesh` (a mesh of this problem's
+    /// domain); the geometric features are computed by the graph.
+    fn columns(&self, mesh: &Mesh<D>) -> Result<Vec<Column>, ProblemError>;
+    /// A new mesh of the domain whose element sizes follow the piecewise-constant field `sizes`
+    /// on `mesh`; the generator refuses to build more than `max_elements` elements.
+    fn remesh(&self, mesh: &Mesh<D>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<D>, ProblemError>;
+}
+
+impl Problem<2> for PoissonProblem {
+    fn feature_set(&self) -> FeatureSet {
+        FeatureSet::poisson()
+    }
+
+    fn initial_mesh(&self) -> &Mesh<2> {
+        &self.initial_mesh
+    }
+
+    fn expert_mesh(&self) -> &Mesh<2> {
+        &self.expert_mesh
+    }
+
+    /// Solves −Δu = f (P1) on `mesh`: `solution_mean`, `solution_std` of u over each element's
+    /// vertices, and `load` = f at the element midpoint.
+    fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
+        let order = self.metadata.heuristic.as_ref().map_or(ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order);
+        let space = P1Space::new(mesh)?;
+        let quadrature = Quadrature::simplex::<2>(order)?;
+        let solution = space.solve_poisson(&space.sample_load(&self.load, &quadrature)?)?;
+        let stats = element_stats(mesh, &solution.u)?;
+        let load = mesh.midpoints().into_iter().map(|x| amber_fem::Load::value(&self.load, x)).collect();
+        Ok(vec![
+            Column { name: "solution_mean".into(), values: stats.iter().map(|s| s.mean).collect() },
+            Column { name: "solution_std".into(), values: stats.iter().map(|s| s.std).collect() },
+            Column { name: "load".into(), values: load },
+        ])
+    }
+
+    fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
+        let domain = PolygonDomain::lshape(self.corner)?;
+        let params = Mesh2dParams::default().with_max_elements(max_elements);
+        Ok(generate_2d(&domain, &MeshSizing::new(mesh, sizes), &params)?)
+    }
+}
+
+/// The clip and the element budget every predicted sizing field passes before meshing (spec
+/// §2, §6), fixed by the training set and reused for validation, test and inference.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MeshLimits {
+    /// h_min: predicted sizes are clipped below at this size.
+    pub min_size: f64,
+    /// Fields whose estimated element count Σ|K|/V(h) exceeds this are not meshed.
+    pub max_elements: usize,
+}
+
+impl MeshLimits {
+    /// h_min = the `min_size_quantile` quantile of all training expert element sizes (0: the
+    /// smallest); budget = ⌊`budget_factor` × the largest training expert's element count⌋.
+    pub fn from_experts<'m, const D: usize>(
+        experts: impl IntoIterator<Item = &'m Mesh<D>>,
+        budget_factor: f64,
+        min_size_quantile: f64,
+    ) -> Self {
+        let mut sizes = Vec::new();
+        let mut largest = 0;
+        for expert in experts {
+            sizes.extend(expert.sizes());
+            largest = largest.max(expert.num_elements());
+        }
+        sizes.sort_by(f64::total_cmp);
+        Self { min_size: quantile(&sizes, min_size_quantile), max_elements: (budget_factor * largest as f64) as usize }
+    }
+
+    /// The generator's own hard cap: a safety net well above the budget (the estimate is only
+    /// an estimate), so a runaway field fails fast instead of meshing millions of elements.
+    pub fn generator_cap(&self) -> usize {
+        self.max_elements.saturating_mul(4).max(1_000)
+    }
+}
+
+/// A mesh with everything the network reads from it: the input columns and the graph.
+#[derive(Clone, Debug)]
+pub struct MeshState<const D: usize> {
+    pub mesh: Mesh<D>,
+    pub columns: Vec<Column>,
+    pub graph: MeshGraph,
+}
+
+impl<const D: usize> MeshState<D> {
+    /// Computes the columns of `mesh` for `problem` and builds its graph.
+    pub fn new<P: Problem<D> + ?Sized>(problem: &P, mesh: Mesh<D>) -> Result<Self, ProblemError> {
+        let columns = problem.columns(&mesh)?;
+        Self::from_columns(&problem.feature_set(), mesh, columns)
+    }
+
+    /// Builds the graph of `mesh` from already computed columns (used when loading checkpoints).
+    pub fn from_columns(features: &FeatureSet, mesh: Mesh<D>, columns: Vec<Column>) -> Result<Self, ProblemError> {
+        let named: Vec<ElementColumn<'_>> =
+            columns.iter().map(|c| ElementColumn { name: &c.name, values: &c.values }).collect();
+        let graph = MeshGraph::new(&mesh, features, &named)?;
+        Ok(Self { mesh, columns, graph })
+    }
+}
+
+/// The labels of `mesh`: the problem's expert sizing field projected onto it (spec §3).
+pub fn labels<const D: usize, P: Problem<D> + ?Sized>(
+    problem: &P,
+    mesh: &Mesh<D>,
+    aggregation: Aggregation,
+) -> Result<Vec<f64>, ProblemError> {
+    Ok(project_expert_sizing(mesh, problem.expert_mesh(), aggregation)?)
+}
+
+/// What became of one generation step.
+#[derive(Clone, Debug)]
+pub enum StepOutcome<const D: usize> {
+    /// The new mesh.
+    Meshed(Mesh<D>),
+    /// The element budget was exceeded: nothing was meshed.
+    OverBudget {
+        /// Σ|K|/V(h) of the clipped field, or the generator's cap when its own cap stopped it.
+        estimated_elements: f64,
+    },
+    /// The generator failed for another reason (reported, not fatal to a training run).
+    Failed { reason: String },
+}
+
+/// One generation step from `mesh` with the predicted per-element `sizes`: clip below at h_min,
+/// check the element budget, mesh.
+pub fn generation_step<const D: usize, P: Problem<D> + ?Sized>(
+    problem: &P,
+    mesh: &Mesh<D>,
+    mut sizes: Vec<f64>,
+    limits: &MeshLimits,
+) -> StepOutcome<D> {
+    // `f64::max` maps NaN to the minimum: a broken prediction asks for the finest mesh, which
+    // the budget then rejects.
+    sizes.iter_mut().for_each(|h| *h = h.max(limits.min_size));
+    let estimated_elements = estimated_element_count(mesh, &sizes);
+    if estimated_elements > limits.max_elements as f64 {
+        return StepOutcome::OverBudget { estimated_elements };
+    }
+    let cap = limits.generator_cap();
+    match problem.remesh(mesh, sizes, cap) {
+        Ok(mesh) => StepOutcome::Meshed(mesh),
+        Err(ProblemError::Meshing(MeshgenError::TooManyElements { cap })) => {
+            StepOutcome::OverBudget { estimated_elements: cap as f64 }
+        }
+        Err(e) => StepOutcome::Failed { reason: e.to_string() },
+    }
+}

@@ -1,0 +1,444 @@
+//! The training loop (spec §6): gradient steps on least-used batches from the replay buffer, a
+//! new generated mesh every `add_interval` steps, checkpoints, a JSON-lines log, validation
+//! rollouts, progress through a [`TrainingObserver`].
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use amber_graph::{FeatureNormaliser, GraphBatch};
+use amber_mesh::Mesh;
+use amber_mpn::{GraphInput, Mpn, MpnConfig, mse};
+use candle_core::{DType, Device, Tensor};
+use candle_nn::VarMap;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::checkpoint::{
+    self, AdditionCounts, EntryRecord, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, TrainingState,
+};
+use crate::error::{Result, TrainError, in_problem, io_error};
+use crate::model::{WEIGHTS_FILE, read_json, write_json};
+use crate::optim::Adam;
+use crate::{
+    AmberModel, Evaluation, EvaluationSummary, MeshLimits, MeshState, Predictor, Problem, ProblemError, ReplayBuffer,
+    Sample, StepOutcome, TargetTransform, TrainingConfig, generation_step, labels,
+};
+
+/// The final model's sub-directory of the output directory.
+pub const MODEL_DIR: &str = "model";
+/// The JSON-lines log in the output directory.
+pub const LOG_FILE: &str = "train.jsonl";
+/// The run's configuration in the output directory.
+pub const CONFIG_FILE: &str = "config.json";
+
+/// What became of one attempted buffer addition.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum Addition {
+    /// A mesh of `depth` with `elements` elements entered the buffer.
+    Added { problem: usize, depth: usize, elements: usize },
+    /// The predicted field exceeded the element budget; nothing was added.
+    OverBudget { problem: usize, depth: usize, estimated_elements: f64 },
+    /// The generator failed; nothing was added.
+    Failed { problem: usize, depth: usize, reason: String },
+}
+
+/// One gradient step (and the addition that followed it, if one was due).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepReport {
+    /// Gradient steps completed, this one included.
+    pub step: u64,
+    /// Loss of the batch (in the objective's training space).
+    pub loss: f64,
+    pub learning_rate: f64,
+    /// Global gradient norm before clipping.
+    pub grad_norm: f64,
+    pub graphs: usize,
+    pub nodes: usize,
+    /// Nodes per second of the gradient step (forward, backward, update).
+    pub nodes_per_s: f64,
+    /// Wall time of the gradient step plus the addition.
+    pub seconds: f64,
+    pub addition: Option<Addition>,
+    pub buffer_size: usize,
+    /// Buffer entries per depth (index = depth).
+    pub buffer_depths: Vec<usize>,
+}
+
+/// Progress callbacks of [`Training::run`] (binaries draw bars with them; the library never
+/// prints). Every method has an empty default.
+pub trait TrainingObserver {
+    /// After every gradient step.
+    fn step(&mut self, _report: &StepReport, _total_steps: u64) {}
+    /// After every validation rollout.
+    fn validation(&mut self, _step: u64, _summary: &EvaluationSummary) {}
+    /// After every checkpoint.
+    fn checkpoint(&mut self, _step: u64, _dir: &Path) {}
+}
+
+/// Observes nothing.
+impl TrainingObserver for () {}
+
+/// A training run: network, optimiser, buffer, normalisers and generators.
+pub struct Training<const D: usize, P: Problem<D>> {
+    config: TrainingConfig,
+    problems: Vec<P>,
+    network: Mpn,
+    varmap: VarMap,
+    optimiser: Adam,
+    predictor: Predictor,
+    buffer: ReplayBuffer<D>,
+    step: u64,
+    dropout_rng: ChaCha8Rng,
+    buffer_rng: ChaCha8Rng,
+    additions: AdditionCounts,
+}
+
+/// A generator of the run's seed on its own stream.
+fn stream(seed: u64, stream: u64) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(stream);
+    rng
+}
+
+fn fingerprints<const D: usize, P: Problem<D>>(problems: &[P]) -> Vec<ProblemFingerprint> {
+    problems
+        .iter()
+        .map(|p| ProblemFingerprint {
+            initial_elements: p.initial_mesh().num_elements(),
+            expert_elements: p.expert_mesh().num_elements(),
+            expert_volume: p.expert_mesh().total_volume(),
+        })
+        .collect()
+}
+
+impl<const D: usize, P: Problem<D>> Training<D, P> {
+    /// A fresh run on `problems`: h_min and the element budget from their experts, one
+    /// protected buffer entry per problem (which also seed the normalisers), a freshly
+    /// initialised network.
+    pub fn new(config: TrainingConfig, problems: Vec<P>) -> Result<Self> {
+        config.validate()?;
+        let first = problems.first().ok_or(TrainError::NoProblems)?;
+        let features = first.feature_set();
+        let limits =
+            MeshLimits::from_experts(problems.iter().map(|p| p.expert_mesh()), config.budget_factor, config.min_size_quantile);
+        let normaliser = config.normalise_inputs.then(|| FeatureNormaliser::new(features.node_dim(), features.edge_dim(D)));
+        let target = TargetTransform::new(config.objective, config.normalise_labels);
+        let network_config = MpnConfig {
+            node_features: features.node_dim(),
+            edge_features: features.edge_dim(D),
+            latent_dim: config.network.latent_dim,
+            steps: config.network.message_passing_steps,
+            edge_dropout: config.network.edge_dropout,
+            output: target.network_output(),
+        };
+        let (network, varmap) = Mpn::init(network_config, config.seed, DType::F32, &Device::Cpu)?;
+        let optimiser = Adam::new(&varmap, config.max_grad_norm)?;
+        let mut training = Self {
+            buffer: ReplayBuffer::new(config.buffer_capacity),
+            dropout_rng: stream(config.seed, 1),
+            buffer_rng: stream(config.seed, 2),
+            config,
+            network,
+            varmap,
+            optimiser,
+            predictor: Predictor { features, normaliser, target, limits },
+            step: 0,
+            additions: AdditionCounts::default(),
+            problems: Vec::new(),
+        };
+        let samples: Vec<Sample<D>> = problems
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| training.sample(p, p.initial_mesh().clone()).map_err(in_problem(i)))
+            .collect::<Result<_>>()?;
+        for (i, sample) in samples.into_iter().enumerate() {
+            training.observe(&sample)?;
+            training.buffer.push_protected(i, sample);
+        }
+        training.problems = problems;
+        Ok(training)
+    }
+
+    /// Resumes the newest checkpoint under `out_dir` if there is one (the configuration and
+    /// problems must be those of the checkpointed run), else starts afresh.
+    pub fn open(config: TrainingConfig, problems: Vec<P>, out_dir: &Path) -> Result<Self> {
+        match checkpoint::latest_checkpoint(out_dir)? {
+            Some(dir) => Self::resume(config, problems, &dir),
+            None => Self::new(config, problems),
+        }
+    }
+
+    /// Restores the run checkpointed in `dir`.
+    pub fn resume(config: TrainingConfig, problems: Vec<P>, dir: &Path) -> Result<Self> {
+        let fail = |message: String| TrainError::Checkpoint { path: dir.into(), message };
+        let state: TrainingState = read_json(&dir.join(STATE_FILE))?;
+        if state.config != config {
+            return Err(fail("the configuration differs from the checkpointed run's".into()));
+        }
+        if state.problems != fingerprints(&problems) {
+            return Err(fail("the training problems differ from the checkpointed run's".into()));
+        }
+        let predictor: Predictor = read_json(&dir.join(crate::model::PREDICTOR_FILE))?;
+        let (network, varmap) = Mpn::load_trainable(&dir.join(WEIGHTS_FILE), DType::F32, &Device::Cpu)?;
+        let mut optimiser = Adam::new(&varmap, config.max_grad_norm)?;
+        optimiser.load(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
+        let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
+            records.par_iter().map(|r| checkpoint::load_entry(dir, r, &predictor.features, &predictor.target)).collect()
+        };
+        let buffer =
+            ReplayBuffer::restore(config.buffer_capacity, state.next_entry_id, load(&state.protected)?, load(&state.generated)?);
+        Ok(Self {
+            dropout_rng: state.dropout_rng.restore(dir)?,
+            buffer_rng: state.buffer_rng.restore(dir)?,
+            config,
+            problems,
+            network,
+            varmap,
+            optimiser,
+            predictor,
+            buffer,
+            step: state.step,
+            additions: state.additions,
+        })
+    }
+
+    /// The run's configuration.
+    pub fn config(&self) -> &TrainingConfig {
+        &self.config
+    }
+
+    /// Gradient steps completed.
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+
+    /// h_min and the element budget of this run (validation and inference use them too).
+    pub fn limits(&self) -> &MeshLimits {
+        &self.predictor.limits
+    }
+
+    /// The replay buffer.
+    pub fn buffer(&self) -> &ReplayBuffer<D> {
+        &self.buffer
+    }
+
+    /// Buffer additions so far, by outcome.
+    pub fn additions(&self) -> AdditionCounts {
+        self.additions
+    }
+
+    /// The network (sharing the trained variables).
+    pub fn network(&self) -> &Mpn {
+        &self.network
+    }
+
+    /// Normalisers, target transform and limits.
+    pub fn predictor(&self) -> &Predictor {
+        &self.predictor
+    }
+
+    /// The training problems.
+    pub fn problems(&self) -> &[P] {
+        &self.problems
+    }
+
+    /// Features and labels of `mesh`, a mesh of `problem`'s domain.
+    fn sample(&self, problem: &P, mesh: Mesh<D>) -> Result<Sample<D>, ProblemError> {
+        let state = MeshState::new(problem, mesh)?;
+        let labels = labels(problem, &state.mesh, self.config.aggregation)?;
+        let targets = self.predictor.target.raw_targets(&labels, &state.mesh.sizes());
+        Ok(Sample { state, labels, targets })
+    }
+
+    /// Merges a graph entering the buffer into the running normalisers.
+    fn observe(&mut self, sample: &Sample<D>) -> Result<()> {
+        if let Some(normaliser) = &mut self.predictor.normaliser {
+            normaliser.update(&sample.state.graph)?;
+        }
+        self.predictor.target.update(&sample.targets);
+        Ok(())
+    }
+
+    /// One gradient step on the next least-used batch, then a buffer addition if one is due.
+    pub fn train_step(&mut self) -> Result<StepReport> {
+        let started = Instant::now();
+        let lr = self.config.lr_schedule.rate(self.config.learning_rate, self.step, self.config.steps);
+        let chosen = self.buffer.next_batch(self.config.batch_nodes);
+        let entries: Vec<_> = chosen.iter().map(|&i| self.buffer.get(i)).collect();
+        let mut batch = GraphBatch::from_graphs(entries.iter().map(|e| &e.sample.state.graph))?;
+        if let Some(normaliser) = &self.predictor.normaliser {
+            normaliser.normalise(&mut batch)?;
+        }
+        let targets: Vec<f32> =
+            entries.iter().flat_map(|e| self.predictor.target.training_targets(&e.sample.targets)).collect();
+        let nodes = batch.num_nodes;
+        let input = GraphInput::from_batch(&batch, DType::F32, &Device::Cpu)?;
+        let output = self.network.forward_train(&input, &mut self.dropout_rng)?;
+        let loss = mse(&output, &Tensor::from_vec(targets, nodes, &Device::Cpu)?)?;
+        let loss_value = f64::from(loss.to_scalar::<f32>()?);
+        let grad_norm = self.optimiser.step(&loss, lr)?;
+        let step_seconds = started.elapsed().as_secs_f64();
+        let addition = if self.step.is_multiple_of(self.config.add_interval) { Some(self.add_generated()?) } else { None };
+        self.step += 1;
+        Ok(StepReport {
+            step: self.step,
+            loss: loss_value,
+            learning_rate: lr,
+            grad_norm,
+            graphs: chosen.len(),
+            nodes,
+            nodes_per_s: nodes as f64 / step_seconds,
+            seconds: started.elapsed().as_secs_f64(),
+            addition,
+            buffer_size: self.buffer.len(),
+            buffer_depths: self.buffer.depth_histogram(),
+        })
+    }
+
+    /// Generates one mesh from a buffer entry chosen by the configured strategy and stores it
+    /// (spec §6): predict (evaluation mode), clip, guard, remesh, features, labels.
+    pub fn add_generated(&mut self) -> Result<Addition> {
+        let source = self
+            .buffer
+            .choose_source(self.config.max_source_depth, self.config.source_selection, &mut self.buffer_rng)
+            .expect("protected depth-0 entries are always eligible");
+        let entry = self.buffer.get(source);
+        let (problem, depth) = (entry.problem, entry.depth + 1);
+        let sizes = self.predictor.predict(&self.network, &[&entry.sample.state])?.pop().expect("one state");
+        let outcome = generation_step(&self.problems[problem], &entry.sample.state.mesh, sizes, &self.predictor.limits);
+        Ok(match outcome {
+            StepOutcome::Meshed(mesh) => {
+                let sample = self.sample(&self.problems[problem], mesh).map_err(in_problem(problem))?;
+                let elements = sample.state.mesh.num_elements();
+                self.observe(&sample)?;
+                self.buffer.push_generated(problem, depth, sample);
+                self.additions.added += 1;
+                Addition::Added { problem, depth, elements }
+            }
+            StepOutcome::OverBudget { estimated_elements } => {
+                self.additions.over_budget += 1;
+                Addition::OverBudget { problem, depth, estimated_elements }
+            }
+            StepOutcome::Failed { reason } => {
+                self.additions.failed += 1;
+                Addition::Failed { problem, depth, reason }
+            }
+        })
+    }
+
+    /// Trains until `config.steps`, from wherever the run stands: logs every step to
+    /// `out_dir/train.jsonl`, validates on `validation` every `validation_interval` steps and at
+    /// the end, checkpoints every `checkpoint_interval` steps and at the end, and writes the
+    /// final model to `out_dir/model`.
+    pub fn run(
+        &mut self,
+        out_dir: &Path,
+        validation: Option<&Evaluation<'_, D, P>>,
+        observer: &mut dyn TrainingObserver,
+    ) -> Result<()> {
+        std::fs::create_dir_all(out_dir).map_err(io_error(out_dir))?;
+        write_json(&out_dir.join(CONFIG_FILE), &self.config)?;
+        let mut log = TrainingLog::open(&out_dir.join(LOG_FILE), self.step)?;
+        let total = self.config.steps;
+        while self.step < total {
+            let report = self.train_step()?;
+            log.write(&LogRecord::Step(&report))?;
+            observer.step(&report, total);
+            let (step, last) = (self.step, self.step == total);
+            let interval = self.config.validation_interval;
+            if let Some(validation) = validation
+                && interval > 0
+                && (step.is_multiple_of(interval) || last)
+            {
+                let summary = self.validate(validation)?;
+                log.write(&LogRecord::Validation { step, summary: &summary })?;
+                observer.validation(step, &summary);
+            }
+            if step.is_multiple_of(self.config.checkpoint_interval) || last {
+                let dir = self.save_checkpoint(out_dir)?;
+                observer.checkpoint(step, &dir);
+            }
+        }
+        self.save_model(&out_dir.join(MODEL_DIR))
+    }
+
+    /// Rolls out the current model on `validation` (evaluation mode) and summarises.
+    pub fn validate(&self, validation: &Evaluation<'_, D, P>) -> Result<EvaluationSummary> {
+        Ok(validation.run(&self.network, &self.predictor, self.config.inference_steps)?.1)
+    }
+
+    /// Writes the current model (network, normalisers, target transform, limits) to `dir`.
+    pub fn save_model(&self, dir: &Path) -> Result<()> {
+        AmberModel::save(&self.network, &self.varmap, &self.predictor, dir)
+    }
+
+    /// Writes a checkpoint of the current state under `out_dir/checkpoints`; returns its
+    /// directory.
+    pub fn save_checkpoint(&self, out_dir: &Path) -> Result<PathBuf> {
+        let records = |entries: &mut dyn Iterator<Item = &crate::BufferEntry<D>>| entries.map(EntryRecord::of).collect();
+        let state = TrainingState {
+            config: self.config.clone(),
+            step: self.step,
+            optimiser_steps: self.optimiser.steps(),
+            dropout_rng: RngState::of(&self.dropout_rng),
+            buffer_rng: RngState::of(&self.buffer_rng),
+            problems: fingerprints(&self.problems),
+            next_entry_id: self.buffer.next_id(),
+            protected: records(&mut self.buffer.protected().iter()),
+            generated: records(&mut self.buffer.generated()),
+            additions: self.additions,
+        };
+        checkpoint::commit(out_dir, self.step, self.buffer.entries(), |dir| {
+            self.save_model(dir)?;
+            self.optimiser.save(&dir.join(OPTIMISER_FILE))?;
+            write_json(&dir.join(STATE_FILE), &state)
+        })
+    }
+}
+
+/// One line of the training log.
+#[derive(Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+enum LogRecord<'a> {
+    Step(&'a StepReport),
+    Validation { step: u64, summary: &'a EvaluationSummary },
+}
+
+/// The JSON-lines log, appended to; on resume, records after the checkpoint are dropped first
+/// (they belong to the killed run's lost steps and will be redone).
+struct TrainingLog {
+    file: std::fs::File,
+    path: PathBuf,
+}
+
+impl TrainingLog {
+    fn open(path: &Path, completed_steps: u64) -> Result<Self> {
+        let kept: String = match std::fs::read_to_string(path) {
+            Ok(text) => text
+                .lines()
+                .filter(|line| {
+                    serde_json::from_str::<serde_json::Value>(line)
+                        .ok()
+                        .and_then(|v| v.get("step").and_then(|s| s.as_u64()))
+                        .is_some_and(|s| s <= completed_steps)
+                })
+                .map(|line| format!("{line}\n"))
+                .collect(),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+            Err(e) => return Err(io_error(path)(e)),
+        };
+        crate::model::write_atomic(path, kept.as_bytes())?;
+        let file = std::fs::OpenOptions::new().append(true).open(path).map_err(io_error(path))?;
+        Ok(Self { file, path: path.into() })
+    }
+
+    fn write(&mut self, record: &LogRecord<'_>) -> Result<()> {
+        let mut line = serde_json::to_vec(record).map_err(|source| TrainError::Json { path: self.path.clone(), source })?;
+        line.push(b'\n');
+        self.file.write_all(&line).map_err(io_error(&self.path))
+    }
+}
