@@ -58,14 +58,26 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut cases = Vec::new();
     for variant in &args.variants {
         // Dropout only exists in training.
-        for mode in args.modes.iter().filter(|m| !(variant == "fast-dropout" && *m == "infer")) {
-            let nodes = if variant == "naive" && mode == "train" { args.naive_nodes.unwrap_or(args.nodes) } else { args.nodes };
+        for mode in args
+            .modes
+            .iter()
+            .filter(|m| !(variant == "fast-dropout" && *m == "infer"))
+        {
+            let nodes = if variant == "naive" && mode == "train" {
+                args.naive_nodes.unwrap_or(args.nodes)
+            } else {
+                args.nodes
+            };
             let edges = args.edges * nodes / args.nodes;
             let case = bench_case(&config, variant, mode, nodes, edges, &args)?;
             println!(
                 "{variant:>13} {mode:5} N={nodes:>7} E={:>7}: median {:8.1} ms  {:>8.0} nodes/s  (CPU {:6.1} s)  peak RSS {:.2} GiB  [other processes {:.2} CPUs]",
-                case["n_edges"], case["s_median"].as_f64().unwrap_or(0.0) * 1e3, case["nodes_per_s"].as_f64().unwrap_or(0.0), case["cpu_s_median"].as_f64().unwrap_or(0.0),
-                case["peak_rss_gib"].as_f64().unwrap_or(f64::NAN), case["other_cpus_median"].as_f64().unwrap_or(0.0)
+                case["n_edges"],
+                case["s_median"].as_f64().unwrap_or(0.0) * 1e3,
+                case["nodes_per_s"].as_f64().unwrap_or(0.0),
+                case["cpu_s_median"].as_f64().unwrap_or(0.0),
+                case["peak_rss_gib"].as_f64().unwrap_or(f64::NAN),
+                case["other_cpus_median"].as_f64().unwrap_or(0.0)
             );
             cases.push(case);
         }
@@ -91,18 +103,38 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(dir) = args.out.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    std::fs::write(&args.out, serde_json::to_string_pretty(&result)?).with_context(|| format!("writing {}", args.out.display()))?;
+    std::fs::write(&args.out, serde_json::to_string_pretty(&result)?)
+        .with_context(|| format!("writing {}", args.out.display()))?;
     println!("wrote {}", args.out.display());
     Ok(())
 }
 
 /// Times one (variant, mode): `infer` is a forward of a plain-tensor model, `train` is forward,
 /// MSE, backward, global-norm clipping at 0.5 and an Adam step.
-fn bench_case(config: &MpnConfig, variant: &str, mode: &str, nodes: usize, edges: usize, args: &Args) -> anyhow::Result<Value> {
+fn bench_case(
+    config: &MpnConfig,
+    variant: &str,
+    mode: &str,
+    nodes: usize,
+    edges: usize,
+    args: &Args,
+) -> anyhow::Result<Value> {
     let dev = Device::Cpu;
-    let graph = GraphInput::from_batch(&random_graph(nodes, edges / 2, config.node_features, config.edge_features, 0), DType::F32, &dev)?;
+    let graph = GraphInput::from_batch(
+        &random_graph(
+            nodes,
+            edges / 2,
+            config.node_features,
+            config.edge_features,
+            0,
+        ),
+        DType::F32,
+        &dev,
+    )?;
     // Sizing-field-like positive targets in [0.01, 0.06), deterministic.
-    let targets: Vec<f32> = (0..nodes).map(|i| 0.01 + 0.05 * ((i as f32 * 0.618_034) % 1.0)).collect();
+    let targets: Vec<f32> = (0..nodes)
+        .map(|i| 0.01 + 0.05 * ((i as f32 * 0.618_034) % 1.0))
+        .collect();
     let targets = Tensor::from_vec(targets, nodes, &dev)?;
     let (model, varmap) = Mpn::init(config.clone(), 0, DType::F32, &dev)?;
     let mut trainer = Trainer::new(&varmap, &TrainConfig::default())?;
@@ -112,9 +144,15 @@ fn bench_case(config: &MpnConfig, variant: &str, mode: &str, nodes: usize, edges
         match (variant, mode) {
             ("naive", "infer") => drop(frozen.forward_naive(&graph)?),
             ("fast", "infer") => drop(frozen.forward(&graph)?),
-            ("naive", "train") => drop(trainer.step(&mse(&model.forward_naive(&graph)?, &targets)?)?),
-            ("fast", "train") => drop(trainer.step(&mse(&model.forward(&graph)?, &targets)?)?),
-            ("fast-dropout", "train") => drop(trainer.step(&mse(&model.forward_train(&graph, &mut rng)?, &targets)?)?),
+            ("naive", "train") => {
+                trainer.step(&mse(&model.forward_naive(&graph)?, &targets)?)?;
+            }
+            ("fast", "train") => {
+                trainer.step(&mse(&model.forward(&graph)?, &targets)?)?;
+            }
+            ("fast-dropout", "train") => {
+                trainer.step(&mse(&model.forward_train(&graph, &mut rng)?, &targets)?)?;
+            }
             _ => bail!("unknown variant/mode {variant}/{mode}"),
         }
         Ok(())
@@ -166,7 +204,13 @@ fn reset_peak_rss() -> bool {
 
 fn peak_rss_gib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let kib: f64 = status.lines().find(|l| l.starts_with("VmHWM:"))?.split_whitespace().nth(1)?.parse().ok()?;
+    let kib: f64 = status
+        .lines()
+        .find(|l| l.starts_with("VmHWM:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()?;
     Some(kib / (1024.0 * 1024.0))
 }
 
@@ -183,7 +227,13 @@ struct CpuLoad {
 impl CpuLoad {
     fn read() -> Option<(u64, u64, u64)> {
         let stat = std::fs::read_to_string("/proc/stat").ok()?;
-        let v: Vec<u64> = stat.lines().next()?.split_whitespace().skip(1).filter_map(|x| x.parse().ok()).collect();
+        let v: Vec<u64> = stat
+            .lines()
+            .next()?
+            .split_whitespace()
+            .skip(1)
+            .filter_map(|x| x.parse().ok())
+            .collect();
         let total: u64 = v.iter().sum();
         let busy = total - v.get(3)? - v.get(4)?;
         let own_stat = std::fs::read_to_string("/proc/self/stat").ok()?;
@@ -199,11 +249,15 @@ impl CpuLoad {
 
     /// CPU seconds (user + system, all threads) this process used since `start`.
     fn own_cpu_s(&self) -> f64 {
-        Self::read().map_or(f64::NAN, |(_, _, own)| (own - self.own) as f64 / CLOCK_TICKS_PER_S)
+        Self::read().map_or(f64::NAN, |(_, _, own)| {
+            (own - self.own) as f64 / CLOCK_TICKS_PER_S
+        })
     }
 
     fn other_cpus(&self) -> f64 {
-        let Some((busy, total, own)) = Self::read() else { return f64::NAN };
+        let Some((busy, total, own)) = Self::read() else {
+            return f64::NAN;
+        };
         let cpus = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
         let other = (busy - self.busy) as f64 - (own - self.own) as f64;
         (other / (total - self.total).max(1) as f64 * cpus).max(0.0)
@@ -211,9 +265,11 @@ impl CpuLoad {
 }
 
 fn machine() -> Value {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_owned()));
+    let cpu = std::fs::read_to_string("/proc/cpuinfo").ok().and_then(|s| {
+        s.lines()
+            .find(|l| l.starts_with("model name"))
+            .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_owned())
+    });
     json!({ "cpu_model": cpu, "cpus": std::thread::available_parallelism().map_or(1, |n| n.get()) })
 }
 
@@ -223,18 +279,33 @@ fn run_peer(python: &Path, args: &Args) -> anyhow::Result<Value> {
     let results = std::env::temp_dir().join(format!("amber-peer-mpn-{}", std::process::id()));
     let status = Command::new(python)
         .arg(&args.peer_script)
-        .args(["--sizes", &args.nodes.to_string(), "--variants", "plain,pyg", "--ckpt-sizes", "", "--self-loops"])
+        .args([
+            "--sizes",
+            &args.nodes.to_string(),
+            "--variants",
+            "plain,pyg",
+            "--ckpt-sizes",
+            "",
+            "--self-loops",
+        ])
         .args(["--steps", &args.iters.to_string()])
         .env("PEERS_RESULTS", &results)
         .env("PEERS_THREADS", args.peer_threads.to_string())
         .env("PEERS_OMP_WAIT_POLICY", "PASSIVE")
         .status()
-        .with_context(|| format!("running {} {}", python.display(), args.peer_script.display()))?;
+        .with_context(|| {
+            format!(
+                "running {} {}",
+                python.display(),
+                args.peer_script.display()
+            )
+        })?;
     if !status.success() {
         bail!("the peer benchmark failed: {status}");
     }
     let path = results.join("mpn.json");
-    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     std::fs::remove_dir_all(&results).ok();
     Ok(serde_json::from_str(&text)?)
 }
@@ -242,11 +313,15 @@ fn run_peer(python: &Path, args: &Args) -> anyhow::Result<Value> {
 /// Speed-ups of the fused variant over the naive one and over each peer case.
 fn ratios(cases: &[Value], peer: Option<&Value>) -> Value {
     let rate = |cs: &[Value], variant: &str, mode: &str| {
-        cs.iter().find(|c| c["variant"] == variant && c["mode"] == mode && c["status"] != "skipped").and_then(|c| c["nodes_per_s"].as_f64())
+        cs.iter()
+            .find(|c| c["variant"] == variant && c["mode"] == mode && c["status"] != "skipped")
+            .and_then(|c| c["nodes_per_s"].as_f64())
     };
     let mut out = serde_json::Map::new();
     for mode in ["train", "infer"] {
-        let Some(fast) = rate(cases, "fast", mode) else { continue };
+        let Some(fast) = rate(cases, "fast", mode) else {
+            continue;
+        };
         if let Some(naive) = rate(cases, "naive", mode) {
             out.insert(format!("fast_over_naive_{mode}"), json!(fast / naive));
         }
