@@ -153,7 +153,8 @@ pub(crate) fn commit<'e, const D: usize>(
     for item in std::fs::read_dir(&root).map_err(io_error(&root))? {
         let path = item.map_err(io_error(&root))?.path();
         let file = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        if file.starts_with("step-") && file != name {
+        // Older checkpoints, and leftovers of a checkpoint write that was killed.
+        if (file.starts_with("step-") || file.starts_with(".tmp-step-")) && file != name {
             remove_dir_if_present(&path)?;
         }
     }

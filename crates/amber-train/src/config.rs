@@ -124,6 +124,9 @@ pub struct TrainingConfig {
     pub normalise_labels: bool,
     /// Normalise node and edge features by their running moments (off: the ablation).
     pub normalise_inputs: bool,
+    /// Append log h(K) to the task's node features (see [`crate::with_log_size`]); not in the
+    /// paper.
+    pub log_size_feature: bool,
     /// The network.
     pub network: NetworkConfig,
     /// Gradient steps.
@@ -176,6 +179,7 @@ impl TrainingConfig {
             objective: Objective::Softplus,
             normalise_labels: false,
             normalise_inputs: true,
+            log_size_feature: false,
             network: NetworkConfig::default(),
             steps: 128_000,
             learning_rate: 3e-4,

@@ -114,7 +114,7 @@ pub fn rollouts<const D: usize, P: Problem<D>>(
     let mut states: Vec<MeshState<D>> = problems
         .par_iter()
         .enumerate()
-        .map(|(i, p)| MeshState::new(p, p.initial_mesh().clone()).map_err(in_problem(i)))
+        .map(|(i, p)| MeshState::new(p, &predictor.features, p.initial_mesh().clone()).map_err(in_problem(i)))
         .collect::<Result<_>>()?;
     let mut out: Vec<Rollout<D>> = problems
         .par_iter()
@@ -150,7 +150,7 @@ pub fn rollouts<const D: usize, P: Problem<D>>(
                 let Some(sizes) = sizes else { return Ok((StepStatus::Stopped, None)) };
                 Ok(match generation_step(&problems[i], &state.mesh, sizes, &predictor.limits) {
                     StepOutcome::Meshed(mesh) => {
-                        (StepStatus::Meshed, Some(MeshState::new(&problems[i], mesh).map_err(in_problem(i))?))
+                        (StepStatus::Meshed, Some(MeshState::new(&problems[i], &predictor.features, mesh).map_err(in_problem(i))?))
                     }
                     StepOutcome::OverBudget { estimated_elements } => (StepStatus::OverBudget { estimated_elements }, None),
                     StepOutcome::Failed { reason } => (StepStatus::Failed { reason }, None),

@@ -4,7 +4,7 @@
 //! task plugs in by implementing [`Problem<3>`].
 
 use amber_fem::{ExpertHeuristic, FemError, P1Space, Quadrature, element_stats};
-use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, project_expert_sizing};
+use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, NodeFeature, project_expert_sizing};
 use amber_mesh::Mesh;
 use amber_meshgen::{Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, estimated_element_count, generate_2d, quantile};
 use amber_metrics::MetricsError;
@@ -132,11 +132,28 @@ pub struct MeshState<const D: usize> {
     pub graph: MeshGraph,
 }
 
+/// Name of the optional node feature log h(K) (see [`with_log_size`]).
+pub const LOG_SIZE_COLUMN: &str = "log_size";
+
+/// `features` with the node feature log h(K) appended: normalised linearly, raw element areas
+/// that span many orders of magnitude (10⁻¹ to 10⁻¹² on the hard Poisson meshes) cannot tell the
+/// small elements apart, yet the size of the current element is what a prediction relative to it
+/// needs most.
+pub fn with_log_size(mut features: FeatureSet) -> FeatureSet {
+    features.node.push(NodeFeature::Column(LOG_SIZE_COLUMN.into()));
+    features
+}
+
 impl<const D: usize> MeshState<D> {
-    /// Computes the columns of `mesh` for `problem` and builds its graph.
-    pub fn new<P: Problem<D> + ?Sized>(problem: &P, mesh: Mesh<D>) -> Result<Self, ProblemError> {
-        let columns = problem.columns(&mesh)?;
-        Self::from_columns(&problem.feature_set(), mesh, columns)
+    /// Computes the columns of `mesh` that `features` needs from `problem` (plus log h(K) if
+    /// asked for) and builds its graph.
+    pub fn new<P: Problem<D> + ?Sized>(problem: &P, features: &FeatureSet, mesh: Mesh<D>) -> Result<Self, ProblemError> {
+        let mut columns = problem.columns(&mesh)?;
+        if features.node.iter().any(|f| *f == NodeFeature::Column(LOG_SIZE_COLUMN.into())) {
+            let values = mesh.sizes().into_iter().map(f64::ln).collect();
+            columns.push(Column { name: LOG_SIZE_COLUMN.into(), values });
+        }
+        Self::from_columns(features, mesh, columns)
     }
 
     /// Builds the graph of `mesh` from already computed columns (used when loading checkpoints).

@@ -24,7 +24,7 @@ use crate::model::{WEIGHTS_FILE, read_json, write_json};
 use crate::optim::Adam;
 use crate::{
     AmberModel, Evaluation, EvaluationSummary, MeshLimits, MeshState, Predictor, Problem, ProblemError, ReplayBuffer,
-    Sample, StepOutcome, TargetTransform, TrainingConfig, generation_step, labels,
+    Sample, StepOutcome, TargetTransform, TrainingConfig, generation_step, labels, with_log_size,
 };
 
 /// The final model's sub-directory of the output directory.
@@ -122,7 +122,10 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
     pub fn new(config: TrainingConfig, problems: Vec<P>) -> Result<Self> {
         config.validate()?;
         let first = problems.first().ok_or(TrainError::NoProblems)?;
-        let features = first.feature_set();
+        let features = match config.log_size_feature {
+            true => with_log_size(first.feature_set()),
+            false => first.feature_set(),
+        };
         let limits =
             MeshLimits::from_experts(problems.iter().map(|p| p.expert_mesh()), config.budget_factor, config.min_size_quantile);
         let normaliser = config.normalise_inputs.then(|| FeatureNormaliser::new(features.node_dim(), features.edge_dim(D)));
@@ -248,7 +251,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
 
     /// Features and labels of `mesh`, a mesh of `problem`'s domain.
     fn sample(&self, problem: &P, mesh: Mesh<D>) -> Result<Sample<D>, ProblemError> {
-        let state = MeshState::new(problem, mesh)?;
+        let state = MeshState::new(problem, &self.predictor.features, mesh)?;
         let labels = labels(problem, &state.mesh, self.config.aggregation)?;
         let targets = self.predictor.target.raw_targets(&labels, &state.mesh.sizes());
         Ok(Sample { state, labels, targets })
