@@ -12,7 +12,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use amber_fem::ExpertHeuristic;
-use amber_tasks::poisson::{DatasetManifest, INITIAL_SIZE, PoissonProblem, Split, SplitRequest, read_split, write_split};
+use amber_tasks::poisson::{
+    DatasetManifest, INITIAL_SIZE, PoissonProblem, Split, SplitRequest, read_split, write_split,
+};
 use amber_train::{Evaluation, EvaluationSummary, Profile, StepReport, Training, TrainingConfig, TrainingObserver};
 use clap::Parser;
 
@@ -100,7 +102,8 @@ impl TrainingObserver for Printer {
         if r.step.is_multiple_of(self.every) || r.step == total {
             let seconds = self.since.elapsed().as_secs_f64();
             println!(
-                "step {:>6}/{total} [{:>6.0} s] loss {:.4} lr {:.2e} {:.0} nodes/step {:.2} steps/s {:.0} nodes/s buffer {:?}",
+                "step {:>6}/{total} [{:>6.0} s] loss {:.4} lr {:.2e} {:.0} nodes/step {:.2} steps/s {:.0} nodes/s \
+                 buffer {:?}",
                 r.step,
                 self.started.elapsed().as_secs_f64(),
                 self.loss / self.count as f64,
@@ -115,8 +118,11 @@ impl TrainingObserver for Printer {
     }
 
     fn validation(&mut self, step: u64, s: &EvaluationSummary) {
-        let per_step: Vec<String> =
-            s.steps.iter().map(|t| format!("{:.3} ({:.0} el, {} failed)", t.normalised_dcd, t.elements, t.failed)).collect();
+        let per_step: Vec<String> = s
+            .steps
+            .iter()
+            .map(|t| format!("{:.3} ({:.0} el, {} failed)", t.normalised_dcd, t.elements, t.failed))
+            .collect();
         println!(
             "validation at step {step} [{:.0} s]: normalised DCD per step {}; d(M0) {:.3} d(M^) {:.3}, expert {:.0} el",
             self.started.elapsed().as_secs_f64(),

@@ -198,7 +198,8 @@ mod tests {
     /// A strip of `n` triangles (so `n` graph nodes).
     fn sample(n: usize) -> Sample<2> {
         let vertices = (0..n + 2).map(|i| [(i / 2) as f64, (i % 2) as f64]).collect();
-        let cells = (0..n as u32).flat_map(|i| if i % 2 == 0 { [i, i + 2, i + 1] } else { [i, i + 1, i + 2] }).collect();
+        let cells =
+            (0..n as u32).flat_map(|i| if i % 2 == 0 { [i, i + 2, i + 1] } else { [i, i + 1, i + 2] }).collect();
         let mesh = Mesh2::new(vertices, cells).unwrap();
         let state = MeshState::from_columns(&FeatureSet::console(), mesh, Vec::new()).unwrap();
         Sample { state, labels: vec![1.0; n], targets: vec![1.0; n] }

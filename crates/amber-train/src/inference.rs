@@ -90,7 +90,11 @@ pub struct Rollout<const D: usize> {
     pub reconstruction_dcd: f64,
 }
 
-fn metrics<const D: usize>(mesh: &Mesh<D>, expert: &Mesh<D>, reference: &Reference<D>) -> Result<MeshMetrics, ProblemError> {
+fn metrics<const D: usize>(
+    mesh: &Mesh<D>,
+    expert: &Mesh<D>,
+    reference: &Reference<D>,
+) -> Result<MeshMetrics, ProblemError> {
     let c = compare_meshes(mesh, expert)?;
     Ok(MeshMetrics {
         dcd: c.midpoints.dcd,
@@ -149,10 +153,13 @@ pub fn rollouts<const D: usize, P: Problem<D>>(
             .map(|(i, (state, sizes))| {
                 let Some(sizes) = sizes else { return Ok((StepStatus::Stopped, None)) };
                 Ok(match generation_step(&problems[i], &state.mesh, sizes, &predictor.limits) {
-                    StepOutcome::Meshed(mesh) => {
-                        (StepStatus::Meshed, Some(MeshState::new(&problems[i], &predictor.features, mesh).map_err(in_problem(i))?))
+                    StepOutcome::Meshed(mesh) => (
+                        StepStatus::Meshed,
+                        Some(MeshState::new(&problems[i], &predictor.features, mesh).map_err(in_problem(i))?),
+                    ),
+                    StepOutcome::OverBudget { estimated_elements } => {
+                        (StepStatus::OverBudget { estimated_elements }, None)
                     }
-                    StepOutcome::OverBudget { estimated_elements } => (StepStatus::OverBudget { estimated_elements }, None),
                     StepOutcome::Failed { reason } => (StepStatus::Failed { reason }, None),
                 })
             })
@@ -278,7 +285,12 @@ impl<'p, const D: usize, P: Problem<D>> Evaluation<'p, D, P> {
     }
 
     /// Rolls out `steps` steps on every problem and summarises.
-    pub fn run(&self, network: &Mpn, predictor: &Predictor, steps: usize) -> Result<(Vec<Rollout<D>>, EvaluationSummary)> {
+    pub fn run(
+        &self,
+        network: &Mpn,
+        predictor: &Predictor,
+        steps: usize,
+    ) -> Result<(Vec<Rollout<D>>, EvaluationSummary)> {
         let rollouts = rollouts(network, predictor, self.problems, &self.references, steps)?;
         let summary = EvaluationSummary::new(self.problems, &rollouts);
         Ok((rollouts, summary))

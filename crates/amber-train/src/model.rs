@@ -34,8 +34,7 @@ impl Predictor {
         if states.is_empty() {
             return Ok(Vec::new());
         }
-        let mut batch = GraphBatch::from_graphs(states.iter().map(|s| &s.graph))
-            ?;
+        let mut batch = GraphBatch::from_graphs(states.iter().map(|s| &s.graph))?;
         if let Some(normaliser) = &self.normaliser {
             normaliser.normalise(&mut batch)?;
         }

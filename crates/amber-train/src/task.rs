@@ -6,7 +6,9 @@
 use amber_fem::{ExpertHeuristic, FemError, P1Space, Quadrature, element_stats};
 use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, NodeFeature, project_expert_sizing};
 use amber_mesh::Mesh;
-use amber_meshgen::{Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, estimated_element_count, generate_2d, quantile};
+use amber_meshgen::{
+    Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, estimated_element_count, generate_2d, quantile,
+};
 use amber_metrics::MetricsError;
 use amber_tasks::poisson::PoissonProblem;
 use serde::{Deserialize, Serialize};
@@ -69,7 +71,11 @@ impl Problem<2> for PoissonProblem {
     /// Solves −Δu = f (P1) on `mesh`: `solution_mean`, `solution_std` of u over each element's
     /// vertices, and `load` = f at the element midpoint.
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-        let order = self.metadata.heuristic.as_ref().map_or(ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order);
+        let order = self
+            .metadata
+            .heuristic
+            .as_ref()
+            .map_or(ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order);
         let space = P1Space::new(mesh)?;
         let quadrature = Quadrature::simplex::<2>(order)?;
         let solution = space.solve_poisson(&space.sample_load(&self.load, &quadrature)?)?;
@@ -147,7 +153,11 @@ pub fn with_log_size(mut features: FeatureSet) -> FeatureSet {
 impl<const D: usize> MeshState<D> {
     /// Computes the columns of `mesh` that `features` needs from `problem` (plus log h(K) if
     /// asked for) and builds its graph.
-    pub fn new<P: Problem<D> + ?Sized>(problem: &P, features: &FeatureSet, mesh: Mesh<D>) -> Result<Self, ProblemError> {
+    pub fn new<P: Problem<D> + ?Sized>(
+        problem: &P,
+        features: &FeatureSet,
+        mesh: Mesh<D>,
+    ) -> Result<Self, ProblemError> {
         let mut columns = problem.columns(&mesh)?;
         if features.node.iter().any(|f| *f == NodeFeature::Column(LOG_SIZE_COLUMN.into())) {
             let values = mesh.sizes().into_iter().map(f64::ln).collect();

@@ -126,9 +126,13 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             true => with_log_size(first.feature_set()),
             false => first.feature_set(),
         };
-        let limits =
-            MeshLimits::from_experts(problems.iter().map(|p| p.expert_mesh()), config.budget_factor, config.min_size_quantile);
-        let normaliser = config.normalise_inputs.then(|| FeatureNormaliser::new(features.node_dim(), features.edge_dim(D)));
+        let limits = MeshLimits::from_experts(
+            problems.iter().map(|p| p.expert_mesh()),
+            config.budget_factor,
+            config.min_size_quantile,
+        );
+        let normaliser =
+            config.normalise_inputs.then(|| FeatureNormaliser::new(features.node_dim(), features.edge_dim(D)));
         let target = TargetTransform::new(config.objective, config.normalise_labels);
         let network_config = MpnConfig {
             node_features: features.node_dim(),
@@ -192,8 +196,12 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
             records.par_iter().map(|r| checkpoint::load_entry(dir, r, &predictor.features, &predictor.target)).collect()
         };
-        let buffer =
-            ReplayBuffer::restore(config.buffer_capacity, state.next_entry_id, load(&state.protected)?, load(&state.generated)?);
+        let buffer = ReplayBuffer::restore(
+            config.buffer_capacity,
+            state.next_entry_id,
+            load(&state.protected)?,
+            load(&state.generated)?,
+        );
         Ok(Self {
             dropout_rng: state.dropout_rng.restore(dir)?,
             buffer_rng: state.buffer_rng.restore(dir)?,
@@ -285,7 +293,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let loss_value = f64::from(loss.to_scalar::<f32>()?);
         let grad_norm = self.optimiser.step(&loss, lr)?;
         let step_seconds = started.elapsed().as_secs_f64();
-        let addition = if self.step.is_multiple_of(self.config.add_interval) { Some(self.add_generated()?) } else { None };
+        let addition =
+            if self.step.is_multiple_of(self.config.add_interval) { Some(self.add_generated()?) } else { None };
         self.step += 1;
         Ok(StepReport {
             step: self.step,
@@ -382,7 +391,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
     /// Writes a checkpoint of the current state under `out_dir/checkpoints`; returns its
     /// directory.
     pub fn save_checkpoint(&self, out_dir: &Path) -> Result<PathBuf> {
-        let records = |entries: &mut dyn Iterator<Item = &crate::BufferEntry<D>>| entries.map(EntryRecord::of).collect();
+        let records =
+            |entries: &mut dyn Iterator<Item = &crate::BufferEntry<D>>| entries.map(EntryRecord::of).collect();
         let state = TrainingState {
             config: self.config.clone(),
             step: self.step,
@@ -440,7 +450,8 @@ impl TrainingLog {
     }
 
     fn write(&mut self, record: &LogRecord<'_>) -> Result<()> {
-        let mut line = serde_json::to_vec(record).map_err(|source| TrainError::Json { path: self.path.clone(), source })?;
+        let mut line =
+            serde_json::to_vec(record).map_err(|source| TrainError::Json { path: self.path.clone(), source })?;
         line.push(b'\n');
         self.file.write_all(&line).map_err(io_error(&self.path))
     }

@@ -7,8 +7,8 @@ use std::path::Path;
 use amber_fem::ExpertHeuristic;
 use amber_tasks::poisson::{Difficulty, INITIAL_SIZE, PoissonProblem};
 use amber_train::{
-    AmberModel, DataConfig, Evaluation, MODEL_DIR, NetworkConfig, Predictor, ReplayBuffer, StepReport, StepStatus, Training, TrainingConfig,
-    TrainingObserver, rollouts,
+    AmberModel, DataConfig, Evaluation, MODEL_DIR, NetworkConfig, Predictor, ReplayBuffer, StepReport, StepStatus,
+    Training, TrainingConfig, TrainingObserver, rollouts,
 };
 
 /// Problems with small experts (8 refinement steps: a few hundred triangles).
@@ -65,14 +65,19 @@ fn training_lowers_the_loss_and_keeps_the_buffer_invariants() {
     let before = log_size_error(&initial.network, &initial.predictor, training.buffer());
     let after = log_size_error(training.network(), training.predictor(), training.buffer());
     assert!(after < before / 3.0, "log-size error {before} -> {after}");
-    assert!(reports.iter().all(|r| r.loss.is_finite() && r.nodes > 0 && (r.nodes <= config.batch_nodes || r.graphs == 1)));
+    assert!(
+        reports.iter().all(|r| r.loss.is_finite() && r.nodes > 0 && (r.nodes <= config.batch_nodes || r.graphs == 1))
+    );
 
     // One addition attempt every `add_interval` steps; protected entries stay, the FIFO is full.
     let additions = training.additions();
     assert_eq!(additions.added + additions.over_budget + additions.failed, config.steps.div_ceil(config.add_interval));
     assert!(additions.added > config.buffer_capacity as u64, "{additions:?}");
     let buffer = training.buffer();
-    assert_eq!(buffer.protected().iter().map(|e| (e.id, e.problem, e.depth)).collect::<Vec<_>>(), [(0, 0, 0), (1, 1, 0)]);
+    assert_eq!(
+        buffer.protected().iter().map(|e| (e.id, e.problem, e.depth)).collect::<Vec<_>>(),
+        [(0, 0, 0), (1, 1, 0)]
+    );
     assert_eq!(buffer.generated().count(), config.buffer_capacity);
     assert!(buffer.generated().all(|e| (1..=config.max_source_depth + 1).contains(&e.depth)));
     let ids: Vec<u64> = buffer.generated().map(|e| e.id).collect();
