@@ -163,7 +163,7 @@ fn main() -> anyhow::Result<()> {
     let started = Instant::now();
     let mut training = Training::open(config.clone(), train, &cli.out)?;
     println!(
-        "{} at step {} ({:.1} s): h_min {:.5}, budget {} elements",
+        "{} at step {} ({:.1} s): h_min {:.3e}, budget {} elements",
         if training.step() > 0 { "resumed" } else { "started" },
         training.step(),
         started.elapsed().as_secs_f64(),

@@ -122,10 +122,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
     pub fn new(config: TrainingConfig, problems: Vec<P>) -> Result<Self> {
         config.validate()?;
         let first = problems.first().ok_or(TrainError::NoProblems)?;
-        let features = match config.log_size_feature {
-            true => with_log_size(first.feature_set()),
-            false => first.feature_set(),
-        };
+        let features =
+            if config.log_size_feature { with_log_size(first.feature_set()) } else { first.feature_set() };
         let limits = MeshLimits::from_experts(
             problems.iter().map(|p| p.expert_mesh()),
             config.budget_factor,
