@@ -64,7 +64,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("amber-cnn", &["amber-mesh", "amber-meshgen", "amber-graph"]),
     ("amber-tasks", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics"]),
     ("amber-train", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics", "amber-mpn", "amber-cnn", "amber-tasks"]),
-    ("amber-cli", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics", "amber-tasks", "amber-train"]),
+    ("amber-experiments", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics", "amber-mpn", "amber-cnn", "amber-tasks", "amber-train"]),
+    ("amber-cli", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics", "amber-tasks", "amber-train", "amber-experiments"]),
 ];
 
 #[test]

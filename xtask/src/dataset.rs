@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use amber_fem::{ExpertHeuristic, P1Space, Quadrature, element_stats};
 use amber_mesh::{RenderOptions, render_png};
 use amber_tasks::poisson::{
-    DatasetManifest, Difficulty, INITIAL_SIZE, PoissonProblem, Split, SplitRequest, read_split, write_split,
+    DatasetManifest, Difficulty, INITIAL_SIZE, PoissonProblem, Split, SplitRequest, read_split, split_dir, write_split,
 };
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -59,15 +59,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     let manifest = DatasetManifest::read(&args.manifest)?;
-    let dir = match (args.split, args.seed) {
-        (Split::Train, seed) => {
-            args.out.join(args.difficulty.name()).join("train").join(format!("seed{}", seed.unwrap_or(0)))
-        }
-        (split, None) => args.out.join(args.difficulty.name()).join(split.name()),
-        (split, Some(_)) => {
-            bail!("--seed selects training problems; the {split} split has a fixed seed in {}", args.manifest.display())
-        }
-    };
+    if args.split != Split::Train && args.seed.is_some() {
+        bail!("--seed selects training problems; the {} split has a fixed seed in {}", args.split, args.manifest.display());
+    }
+    let dir = split_dir(&args.out, args.difficulty, args.split, args.seed.unwrap_or(0));
     let (split_seed, size) = manifest.split(args.split, args.seed.unwrap_or(0), &args.manifest)?;
     let request = SplitRequest {
         difficulty: args.difficulty,

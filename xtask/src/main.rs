@@ -3,13 +3,16 @@
 //! Every command writes its results atomically under `results/` (or `--out`), with the settings
 //! and the machine beside the numbers.
 
+mod bench_cnn;
 mod bench_fem;
 mod bench_mesher;
+mod bench_mesher3d;
 mod bench_metrics;
 mod bench_mpn;
 mod dataset;
 mod reference_distances;
 mod report;
+mod reproduce;
 
 use clap::{Parser, Subcommand};
 
@@ -29,18 +32,26 @@ enum Command {
     Dataset(dataset::Args),
     /// d(M⁰, M*) and d(M̂, M*) on a dataset split: the anchors of the normalised DCD.
     ReferenceDistances(reference_distances::Args),
+    /// Reproduce an experiment of the paper: results.json, table.md and plots under results/.
+    Reproduce(reproduce::Args),
+    /// The paper's ablations on Poisson hard (results/ablate/).
+    Ablate(reproduce::AblateArgs),
 }
 
 #[derive(Subcommand)]
 enum Bench {
     /// The 2D generator on a graded L-shape at ~10k/100k/1M triangles, next to spade's refine().
     Mesher(bench_mesher::Args),
+    /// The 3D generator on the Console train/val parts with the expert's own sizing field.
+    Mesher3d(bench_mesher3d::Args),
     /// DCD of 1M vs 1M points and the 42k → 5k label projection.
     Metrics(bench_metrics::Args),
     /// P1 Poisson: one hard 75-step expert run, assemble + solve at ~200k and ~1M triangles.
     Fem(bench_fem::Args),
     /// MPN train step and inference on a 50k-node graph: fused ops vs stock candle (vs PyTorch).
     Mpn(bench_mpn::Args),
+    /// U-Net train step and inference on 1×4×256² and 1×1×64³ (vs PyTorch).
+    Cnn(bench_cnn::Args),
 }
 
 #[global_allocator]
@@ -55,10 +66,14 @@ fn main() -> anyhow::Result<()> {
     std::env::set_current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))?;
     match Cli::parse().command {
         Command::Bench(Bench::Mesher(args)) => bench_mesher::run(args),
+        Command::Bench(Bench::Mesher3d(args)) => bench_mesher3d::run(args),
         Command::Bench(Bench::Metrics(args)) => bench_metrics::run(args),
         Command::Bench(Bench::Fem(args)) => bench_fem::run(args),
         Command::Bench(Bench::Mpn(args)) => bench_mpn::run(args),
+        Command::Bench(Bench::Cnn(args)) => bench_cnn::run(args),
         Command::Dataset(args) => dataset::run(args),
         Command::ReferenceDistances(args) => reference_distances::run(args),
+        Command::Reproduce(args) => reproduce::run(args),
+        Command::Ablate(args) => reproduce::ablate(args),
     }
 }

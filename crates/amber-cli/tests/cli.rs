@@ -40,3 +40,80 @@ fn bad_input_fails_with_a_message_not_a_panic() {
         assert!(stderr.to_lowercase().contains("error") && !stderr.contains("panicked"), "{args:?}: {stderr}");
     }
 }
+
+#[test]
+fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/poisson.json");
+    let run = dir.path().join("run");
+    let data = dir.path().join("data");
+    let config = dir.path().join("config.json");
+    std::fs::write(&config, r#"{"steps": 40, "checkpoint_interval": 5, "validation_interval": 0}"#).unwrap();
+    let train = || {
+        let mut command = amber();
+        command
+            .args(["train", "--profile", "smoke", "--difficulty", "easy", "--config"])
+            .arg(&config)
+            .arg("--out")
+            .arg(&run)
+            .arg("--data")
+            .arg(&data)
+            .arg("--manifest")
+            .arg(&manifest)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped());
+        command
+    };
+    // Kill the first run once it has checkpointed (or let it finish on a very fast machine).
+    let mut first = train().spawn().unwrap();
+    let checkpoint = run.join("checkpoints/step-00000010");
+    while !checkpoint.exists() && first.try_wait().unwrap().is_none() {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    first.kill().ok();
+    first.wait().unwrap();
+    // The same command resumes from the newest checkpoint and finishes.
+    let output = train().output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(run.join("model/model.safetensors").exists());
+    let log = std::fs::read_to_string(run.join("train.jsonl")).unwrap();
+    let steps: Vec<u64> = log
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter(|v| v["kind"] == "step")
+        .map(|v| v["step"].as_u64().unwrap())
+        .collect();
+    assert_eq!(steps, (1..=40).collect::<Vec<_>>(), "every step logged once, across the kill");
+
+    let problem_file = data.join("easy/val/000.json");
+    let out = dir.path().join("generated");
+    let output = amber()
+        .args(["generate", "--steps", "2", "--model"])
+        .arg(run.join("model"))
+        .arg("--problem")
+        .arg(&problem_file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    for file in ["step1.vtu", "step2.vtu", "step1.png", "step2.png", "metrics.json"] {
+        assert!(out.join(file).exists(), "{file} missing");
+    }
+    let mesh = amber_mesh::read_mesh::<2>(out.join("step2.vtu")).unwrap();
+    let problem = amber_tasks::poisson::read_problem(&problem_file).unwrap();
+    assert!((mesh.total_volume() - problem.expert_mesh.total_volume()).abs() < 1e-9);
+    let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(metrics["steps"].as_array().unwrap().len(), 2);
+
+    // A missing model is an error with a message, not a panic.
+    let output = amber()
+        .args(["generate", "--model", "/nonexistent", "--problem"])
+        .arg(&problem_file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("/nonexistent") && !stderr.contains("panicked"), "{stderr}");
+}

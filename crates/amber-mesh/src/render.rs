@@ -108,17 +108,34 @@ pub fn render_png(
             expected: mesh.num_elements(),
         });
     }
+    let image = render_rgb(mesh, values, options).map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
+    write_png(path, options.width, options.height, &image)
+}
+
+/// The picture [`render_png`] writes, as row-major RGB bytes (`3 × width × height`), for
+/// composing several meshes into one image; the error says what is wrong with the input.
+pub fn render_rgb(mesh: &Mesh2, values: &[f64], options: &RenderOptions) -> Result<Vec<u8>, String> {
+    if values.len() != mesh.num_elements() {
+        return Err(format!("{} rendered values for {} elements", values.len(), mesh.num_elements()));
+    }
     let (w, h) = (options.width, options.height);
     if !(MIN_SIZE..=MAX_SIZE).contains(&w) || !(MIN_SIZE..=MAX_SIZE).contains(&h) {
+        return Err(format!("image size {w}×{h} is outside {MIN_SIZE}..={MAX_SIZE} pixels per side"));
+    }
+    Ok(render(mesh, values, options)?.0)
+}
+
+/// Writes row-major RGB bytes as a PNG file, atomically.
+pub fn write_png(path: impl AsRef<Path>, width: u32, height: u32, rgb: &[u8]) -> Result<(), MeshError> {
+    let path = path.as_ref();
+    if rgb.len() != 3 * width as usize * height as usize {
         return Err(MeshError::Format {
             path: path.to_owned(),
-            message: format!("image size {w}×{h} is outside {MIN_SIZE}..={MAX_SIZE} pixels per side"),
+            message: format!("{} bytes are not a {width}×{height} RGB image", rgb.len()),
         });
     }
-    let (image, _) =
-        render(mesh, values, options).map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
     write_atomic(path, |out| {
-        encode_png(out, w, h, &image).map_err(|source| MeshError::Io { path: path.to_owned(), source })
+        encode_png(out, width, height, rgb).map_err(|source| MeshError::Io { path: path.to_owned(), source })
     })
 }
 

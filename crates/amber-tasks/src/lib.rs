@@ -6,6 +6,7 @@
 //! Depends on the mesh, meshing and FEM layers; it knows nothing of graphs or learning, and never
 //! prints (progress is reported through a callback).
 
+pub mod console;
 mod error;
 pub mod poisson;
 

@@ -26,6 +26,9 @@ pub enum TrainError {
     /// The network failed (shapes, candle, checkpoint files).
     #[error("network: {0}")]
     Network(#[from] MpnError),
+    /// The CNN baseline failed (configuration, rasterisation, shapes, model files).
+    #[error("CNN: {0}")]
+    Cnn(#[from] amber_cnn::CnnError),
     /// A file or directory could not be read or written.
     #[error("{path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },

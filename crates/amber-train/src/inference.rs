@@ -90,7 +90,7 @@ pub struct Rollout<const D: usize> {
     pub reconstruction_dcd: f64,
 }
 
-fn metrics<const D: usize>(
+pub(crate) fn metrics<const D: usize>(
     mesh: &Mesh<D>,
     expert: &Mesh<D>,
     reference: &Reference<D>,

@@ -15,7 +15,9 @@
 
 mod buffer;
 mod checkpoint;
+mod cnn;
 mod config;
+mod console;
 mod error;
 mod inference;
 mod model;
@@ -26,6 +28,10 @@ mod train;
 
 pub use buffer::{BufferEntry, ReplayBuffer, Sample};
 pub use checkpoint::{AdditionCounts, CHECKPOINTS_DIR, latest_checkpoint};
+pub use cnn::{
+    CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnConfig, CnnModel, CnnObserver, CnnPredictor, CnnStepReport, CnnTraining,
+    cnn_rollouts,
+};
 pub use config::{DataConfig, LrSchedule, NetworkConfig, Objective, Profile, SourceSelection, TrainingConfig};
 pub use error::{Result, TrainError};
 pub use inference::{

@@ -4,7 +4,10 @@
 use std::cmp::Ordering::{self, Equal, Greater, Less};
 
 use rayon::prelude::*;
-use rstar::{AABB, RTree, primitives::GeomWithData, primitives::Rectangle};
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+use rstar::{AABB, Envelope};
 
 use super::predicates::{orient2d, orient3d};
 
@@ -16,7 +19,7 @@ type Triangle = [[f64; 3]; 3];
 /// end of the intersection segment lies on an edge of one of them; if they are coplanar, either
 /// edges cross or one triangle holds an edge of the other.
 pub(crate) fn triangles_intersect(t: &Triangle, u: &Triangle) -> bool {
-    (0..3).any(|i| segment_meets_triangle(t[i], t[(i + 1) % 3], u) || segment_meets_triangle(u[i], u[(i + 1) % 3], t))
+    !clearly_apart(t, u) && (0..3).any(|i| segment_meets_triangle(t[i], t[(i + 1) % 3], u) || segment_meets_triangle(u[i], u[(i + 1) % 3], t))
 }
 
 /// Whether the closed segment [p, q] meets the closed triangle `t`.
@@ -47,16 +50,62 @@ pub(crate) fn triangles_overlap(t: [u32; 3], tc: &Triangle, u: [u32; 3], uc: &Tr
         [] => triangles_intersect(tc, uc),
         [k] => {
             let ((a, b), (c, d)) = (opposite(t, tc, k), opposite(u, uc, k));
-            segment_meets_triangle(a, b, uc) || segment_meets_triangle(c, d, tc)
+            (!clearly_apart(&[a, b], uc) && segment_meets_triangle(a, b, uc))
+                || (!clearly_apart(&[c, d], tc) && segment_meets_triangle(c, d, tc))
         }
         [k, l] => {
             let apex = |x: [u32; 3], xc: &Triangle| xc[(0..3).find(|&j| x[j] != t[k] && x[j] != t[l]).unwrap_or(0)];
             let (a, b) = (apex(t, tc), apex(u, uc));
             let [p2, q2, a2, b2] = flatten(tc, [tc[k], tc[l], a, b]);
-            orient3d(tc[k], tc[l], a, b) == Equal && orient2d(p2, q2, a2) == orient2d(p2, q2, b2)
+            // The side test first: it settles the common unfolded case without the (for
+            // coplanar neighbours always exact, hence slow) orientation test.
+            orient2d(p2, q2, a2) == orient2d(p2, q2, b2) && orient3d(tc[k], tc[l], a, b) == Equal
         }
         _ => true,
     }
+}
+
+/// A floating-point separating-axis test with a safety margin: `true` proves that the convex
+/// hulls of `p` and `q` (segments or triangles) are disjoint; `false` proves nothing. It spares
+/// the exact predicates the nearly coplanar pairs of a flat surface, where their floating-point
+/// filters always fail. Axes: the normals of the triangles, the cross products of all edge
+/// pairs, and each normal crossed with every edge (the in-plane separations).
+fn clearly_apart(p: &[[f64; 3]], q: &[[f64; 3]]) -> bool {
+    let edges = |x: &[[f64; 3]]| -> Vec<[f64; 3]> {
+        (0..x.len()).filter(|&i| x.len() > 2 || i == 0).map(|i| sub(x[(i + 1) % x.len()], x[i])).collect()
+    };
+    let (ep, eq) = (edges(p), edges(q));
+    let scale = p.iter().chain(q).flatten().fold(1.0f64, |m, &c| m.max(c.abs()));
+    let separates = |axis: [f64; 3]| {
+        let length = dot(axis, axis).sqrt();
+        if length == 0.0 || !length.is_finite() {
+            return false;
+        }
+        let range = |x: &[[f64; 3]]| {
+            x.iter().map(|&v| dot(axis, v)).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
+        };
+        let ((plo, phi), (qlo, qhi)) = (range(p), range(q));
+        // Rounding in the dot products is a few ulps of length × scale; 1e-10 is far above it.
+        let margin = 1e-10 * length * scale;
+        plo > qhi + margin || qlo > phi + margin
+    };
+    let normals: Vec<[f64; 3]> =
+        [(p, &ep), (q, &eq)].iter().filter(|(x, _)| x.len() == 3).map(|(_, e)| cross(e[0], e[1])).collect();
+    normals.iter().any(|&n| separates(n))
+        || ep.iter().any(|&a| eq.iter().any(|&b| separates(cross(a, b))))
+        || normals.iter().any(|&n| ep.iter().chain(&eq).any(|&e| separates(cross(n, e))))
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// Drops the coordinate along which the triangle's normal is largest (a projection that keeps
@@ -110,28 +159,84 @@ pub(crate) fn triangle_box(c: &Triangle) -> AABB<[f64; 3]> {
     AABB::from_corners(lo, hi)
 }
 
-/// An R-tree of triangle bounding boxes, each tagged with the triangle's index. Entries are
-/// only added: callers re-insert a triangle whose corners changed and check candidates against
-/// its current corners, so stale boxes cost a little time and never hide a triangle.
-pub(crate) struct TriangleIndex(RTree<GeomWithData<Rectangle<[f64; 3]>, u32>>);
+/// A uniform grid of triangle bounding boxes, each tagged with the triangle's index (cells
+/// twice as large as the mean box, hashed). Entries are only added: callers re-insert a
+/// triangle whose corners changed and check candidates against its current corners, so stale
+/// boxes cost a little time and never hide a triangle.
+pub(crate) struct TriangleIndex {
+    cell: f64,
+    cells: HashMap<[i64; 3], Vec<(u32, AABB<[f64; 3]>)>, BuildHasherDefault<CellHasher>>,
+}
 
 impl TriangleIndex {
     pub(crate) fn new(boxes: impl Iterator<Item = (u32, AABB<[f64; 3]>)>) -> Self {
-        Self(RTree::bulk_load(
-            boxes.map(|(t, b)| GeomWithData::new(Rectangle::from_corners(b.lower(), b.upper()), t)).collect(),
-        ))
+        let boxes: Vec<(u32, AABB<[f64; 3]>)> = boxes.collect();
+        let extent = |b: &AABB<[f64; 3]>| (0..3).map(|k| b.upper()[k] - b.lower()[k]).fold(0.0, f64::max);
+        let mean = boxes.iter().map(|(_, b)| extent(b)).sum::<f64>() / boxes.len().max(1) as f64;
+        // Twice the mean: most boxes then touch at most two cells per axis, also after the
+        // remesher has made triangles larger.
+        let cell = if mean.is_finite() && mean > 0.0 { 2.0 * mean } else { 1.0 };
+        let mut index = Self { cell, cells: HashMap::default() };
+        boxes.into_iter().for_each(|(t, b)| index.insert(t, b));
+        index
+    }
+
+    /// The cells a box covers, as an inclusive index range per axis.
+    fn range(&self, b: &AABB<[f64; 3]>) -> ([i64; 3], [i64; 3]) {
+        let cell = |x: f64| (x / self.cell).floor() as i64;
+        (b.lower().map(cell), b.upper().map(cell))
     }
 
     pub(crate) fn insert(&mut self, t: u32, b: AABB<[f64; 3]>) {
-        self.0.insert(GeomWithData::new(Rectangle::from_corners(b.lower(), b.upper()), t));
+        let (lo, hi) = self.range(&b);
+        for i in lo[0]..=hi[0] {
+            for j in lo[1]..=hi[1] {
+                for k in lo[2]..=hi[2] {
+                    self.cells.entry([i, j, k]).or_default().push((t, b));
+                }
+            }
+        }
     }
 
-    /// Indices whose (possibly stale) box meets `b`, each once.
+    /// Indices whose (possibly stale) box meets `b`, each once, sorted.
     pub(crate) fn candidates(&self, b: AABB<[f64; 3]>) -> Vec<u32> {
-        let mut c: Vec<u32> = self.0.locate_in_envelope_intersecting(b).map(|e| e.data).collect();
+        let (lo, hi) = self.range(&b);
+        let mut c = Vec::new();
+        for i in lo[0]..=hi[0] {
+            for j in lo[1]..=hi[1] {
+                for k in lo[2]..=hi[2] {
+                    if let Some(entries) = self.cells.get(&[i, j, k]) {
+                        c.extend(entries.iter().filter(|(_, e)| e.intersects(&b)).map(|&(t, _)| t));
+                    }
+                }
+            }
+        }
         c.sort_unstable();
         c.dedup();
         c
+    }
+}
+
+/// A multiplicative hash of grid cell indices (the default SipHash costs more than the
+/// lookups it serves).
+#[derive(Default)]
+pub(crate) struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        bytes.iter().for_each(|&b| self.write_u64(b as u64));
+    }
+
+    fn write_i64(&mut self, x: i64) {
+        self.write_u64(x as u64);
+    }
+
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
     }
 }
 

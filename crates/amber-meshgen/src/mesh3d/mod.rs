@@ -2,15 +2,18 @@
 //!
 //! [`surface`] reads and validates the geometry (STL with CAD face ids, plain STL, OBJ);
 //! [`mod@remesh`] adapts the surface to a sizing field, keeping CAD faces, curves and corners;
-//! [`tetgen`] fills a closed surface with tets following the same field. Exact predicates and
-//! triangle intersection tests are private helpers.
+//! [`tetgen`] fills a closed surface with tets following the same field; [`generate_3d`] runs
+//! both, capped by curvature and by an element budget. Exact predicates and triangle
+//! intersection tests are private helpers.
 
+mod generate;
 mod intersect;
 mod predicates;
 pub mod remesh;
 pub mod surface;
 pub mod tetgen;
 
+pub use generate::{Mesh3dError, Mesh3dParams, adapt_surface, fill_surface, generate_3d};
 pub use remesh::{RemeshError, RemeshParams, remesh};
 pub use surface::{StlFaceIds, Surface, SurfaceDefect, SurfaceError, SurfaceReport};
 pub use tetgen::{

@@ -11,12 +11,12 @@
 //! would cross another are refused, and vertices whose move (split or smoothing) made
 //! triangles cross go back to where they were safe.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 use rstar::primitives::Line;
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
-use super::intersect::{TriangleIndex, intersecting_pairs, triangle_box, triangles_overlap};
+use super::intersect::{TriangleIndex, triangle_box, triangles_intersect, triangles_overlap};
 use super::surface::{Surface, SurfaceDefect};
 use crate::SizingField;
 
@@ -57,18 +57,21 @@ pub enum RemeshError {
 
 /// Remeshes a validated (closed, outward) `reference` surface so that its edges follow `sizing`,
 /// keeping every CAD face, curve and corner. The result is validated.
+///
+/// Sizes are evaluated at the vertices (when they are created or moved) and an edge's target is
+/// the mean of its two ends, so the field is queried about once per vertex and iteration.
 pub fn remesh<S: SizingField<3>>(
     reference: &Surface,
     sizing: &S,
     params: &RemeshParams,
 ) -> Result<Surface, RemeshError> {
     let context = Context { sizing, projector: Projector::new(reference), params: *params };
-    let mut mesh = WorkMesh::new(reference);
+    let mut mesh = WorkMesh::new(reference, &context)?;
     for _ in 0..params.iterations {
         mesh.split_long_edges(&context)?;
-        mesh.collapse_short_edges(&context)?;
-        mesh.flip_toward_valence_six(&context)?;
-        mesh.smooth_and_project(&context.projector);
+        mesh.collapse_short_edges(&context);
+        mesh.flip_edges(&context);
+        mesh.smooth_and_project(&context)?;
     }
     let mut surface = mesh.into_surface()?;
     surface.validate()?;
@@ -88,12 +91,12 @@ impl<S: SizingField<3>> Context<'_, S> {
         if value.is_finite() && value > 0.0 { Ok(value) } else { Err(RemeshError::InvalidSize { at: p, value }) }
     }
 
-    /// Whether an edge p–q on `kind` (a face, or the curve of a feature edge) stays close
-    /// enough to the reference at its midpoint.
-    fn follows_reference(&self, p: [f64; 3], q: [f64; 3], kind: Kind) -> Result<bool, RemeshError> {
+    /// Whether an edge p–q of target size `h` on `kind` (a face, or the curve of a feature
+    /// edge) stays close enough to the reference at its midpoint.
+    fn follows_reference(&self, p: [f64; 3], q: [f64; 3], kind: Kind, h: f64) -> bool {
         let mid = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
         let deviation = norm(sub(self.projector.project(mid, kind), mid));
-        Ok(deviation <= self.params.max_relative_deviation * self.size(mid)?)
+        deviation <= self.params.max_relative_deviation * h
     }
 }
 
@@ -116,17 +119,21 @@ fn kind_of(faces: &mut Vec<i32>) -> Kind {
     }
 }
 
-/// Closest points on the reference surface, restricted to one CAD face or one curve.
+/// Closest points on the reference surface, restricted to one CAD face or one curve. Planar
+/// faces (most of a sheet-metal part) project onto their plane: a vertex inside a planar face
+/// whose triangles keep their orientation cannot leave the face, so the plane is enough.
 struct Projector {
     faces: HashMap<i32, RTree<RefTriangle>>,
+    /// Point and unit normal of every planar face.
+    planes: HashMap<i32, ([f64; 3], [f64; 3])>,
     curves: HashMap<(i32, i32), RTree<Line<[f64; 3]>>>,
 }
 
 impl Projector {
     fn new(reference: &Surface) -> Self {
         let (v, t, ids) = (reference.vertices(), reference.triangles(), reference.face_ids());
-        let mut faces: HashMap<i32, Vec<RefTriangle>> = HashMap::new();
-        let mut edge_faces: HashMap<[u32; 2], Vec<i32>> = HashMap::new();
+        let mut faces: BTreeMap<i32, Vec<RefTriangle>> = BTreeMap::new();
+        let mut edge_faces: BTreeMap<[u32; 2], Vec<i32>> = BTreeMap::new();
         for (tri, &id) in t.iter().zip(ids) {
             faces.entry(id).or_default().push(RefTriangle(tri.map(|i| v[i as usize])));
             for k in 0..3 {
@@ -134,7 +141,7 @@ impl Projector {
                 edge_faces.entry([a.min(b), a.max(b)]).or_default().push(id);
             }
         }
-        let mut curves: HashMap<(i32, i32), Vec<Line<[f64; 3]>>> = HashMap::new();
+        let mut curves: BTreeMap<(i32, i32), Vec<Line<[f64; 3]>>> = BTreeMap::new();
         for ([a, b], ids) in edge_faces {
             if let [f, g] = ids[..]
                 && f != g
@@ -142,21 +149,46 @@ impl Projector {
                 curves.entry((f.min(g), f.max(g))).or_default().push(Line::new(v[a as usize], v[b as usize]));
             }
         }
+        let planes = faces.iter().filter_map(|(&id, tris)| Some((id, plane_of(tris)?))).collect();
         Self {
             faces: faces.into_iter().map(|(id, tris)| (id, RTree::bulk_load(tris))).collect(),
+            planes,
             curves: curves.into_iter().map(|(key, lines)| (key, RTree::bulk_load(lines))).collect(),
         }
     }
 
     fn project(&self, p: [f64; 3], kind: Kind) -> [f64; 3] {
         match kind {
-            Kind::Face(f) => self.faces.get(&f).and_then(|tree| tree.nearest_neighbor(p)).map_or(p, |t| t.closest(p)),
+            Kind::Face(f) => match self.planes.get(&f) {
+                Some(&(origin, n)) => axpy(p, -dot(sub(p, origin), n), n),
+                None => self.faces.get(&f).and_then(|tree| tree.nearest_neighbor(p)).map_or(p, |t| t.closest(p)),
+            },
             Kind::Curve(f, g) => {
                 self.curves.get(&(f, g)).and_then(|tree| tree.nearest_neighbor(p)).map_or(p, |l| l.nearest_point(&p))
             }
             Kind::Corner => p,
         }
     }
+
+    fn is_planar(&self, face: i32) -> bool {
+        self.planes.contains_key(&face)
+    }
+}
+
+/// The plane of a face whose triangles all lie in one (within 10⁻⁵ of the face's extent,
+/// which float32 STL coordinates respect and any real bend or hole wall exceeds).
+fn plane_of(triangles: &[RefTriangle]) -> Option<([f64; 3], [f64; 3])> {
+    let corners = || triangles.iter().flat_map(|t| t.0);
+    let count = 3.0 * triangles.len() as f64;
+    let origin = corners().fold([0.0; 3], add).map(|c| c / count);
+    let n = triangles.iter().fold([0.0; 3], |acc, t| add(acc, cross(sub(t.0[1], t.0[0]), sub(t.0[2], t.0[0]))));
+    let length = norm(n);
+    if length == 0.0 {
+        return None;
+    }
+    let n = n.map(|c| c / length);
+    let extent = corners().map(|c| norm(sub(c, origin))).fold(0.0, f64::max);
+    corners().all(|c| dot(sub(c, origin), n).abs() <= 1e-5 * extent).then_some((origin, n))
 }
 
 /// A reference triangle in an R-tree that answers distance queries exactly.
@@ -213,20 +245,28 @@ impl PointDistance for RefTriangle {
     }
 }
 
-/// The surface being remeshed: triangles with their CAD faces and vertex → triangle lists.
-/// Removed triangles and vertices stay as tombstones until [`WorkMesh::into_surface`].
+/// The surface being remeshed: triangles with their CAD faces, vertex → triangle lists and the
+/// target size at every vertex. Removed triangles and vertices stay as tombstones until
+/// [`WorkMesh::into_surface`].
 struct WorkMesh {
     pos: Vec<[f64; 3]>,
     kind: Vec<Kind>,
+    /// Target size at each vertex, and where it was evaluated.
+    h: Vec<f64>,
+    sized_at: Vec<[f64; 3]>,
     vertex_alive: Vec<bool>,
     triangles: Vec<[u32; 3]>,
     face: Vec<i32>,
     triangle_alive: Vec<bool>,
+    live_triangles: usize,
     around: Vec<Vec<u32>>,
 }
 
+/// A triangle quality below which no operation may push a triangle (unless it was worse before).
+const MIN_QUALITY: f64 = 0.15;
+
 impl WorkMesh {
-    fn new(s: &Surface) -> Self {
+    fn new<S: SizingField<3>>(s: &Surface, context: &Context<S>) -> Result<Self, RemeshError> {
         let n = s.vertices().len();
         let mut around: Vec<Vec<u32>> = vec![Vec::with_capacity(6); n];
         for (t, tri) in s.triangles().iter().enumerate() {
@@ -234,19 +274,19 @@ impl WorkMesh {
         }
         let kind =
             around.iter().map(|ts| kind_of(&mut ts.iter().map(|&t| s.face_ids()[t as usize]).collect())).collect();
-        Self {
+        let h = s.vertices().iter().map(|&p| context.size(p)).collect::<Result<_, _>>()?;
+        Ok(Self {
             pos: s.vertices().to_vec(),
             kind,
+            h,
+            sized_at: s.vertices().to_vec(),
             vertex_alive: vec![true; n],
             triangles: s.triangles().to_vec(),
             face: s.face_ids().to_vec(),
             triangle_alive: vec![true; s.triangles().len()],
+            live_triangles: s.triangles().len(),
             around,
-        }
-    }
-
-    fn num_triangles(&self) -> usize {
-        self.triangle_alive.iter().filter(|&&a| a).count()
+        })
     }
 
     /// Every edge once, as (smaller, larger) vertex index.
@@ -286,9 +326,9 @@ impl WorkMesh {
         norm(sub(self.pos[a as usize], self.pos[b as usize]))
     }
 
-    fn midpoint(&self, a: u32, b: u32) -> [f64; 3] {
-        let (p, q) = (self.pos[a as usize], self.pos[b as usize]);
-        [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]))
+    /// The target length of edge (a, b): the mean of the sizes at its ends.
+    fn edge_size(&self, a: u32, b: u32) -> f64 {
+        0.5 * (self.h[a as usize] + self.h[b as usize])
     }
 
     fn normal(&self, tri: [u32; 3]) -> [f64; 3] {
@@ -296,53 +336,79 @@ impl WorkMesh {
         cross(sub(b, a), sub(c, a))
     }
 
-    /// Splits every edge longer than 4/3 of the size at its midpoint, repeating until none is
-    /// (or for at most 16 rounds, which halve edges 2^16-fold).
+    fn quality(&self, tri: [u32; 3]) -> f64 {
+        quality(tri.map(|v| self.pos[v as usize]))
+    }
+
+    /// Splits every edge longer than 4/3 of its target, repeating on the new edges until none
+    /// is (or for at most 16 rounds, which halve edges 2^16-fold).
     fn split_long_edges<S: SizingField<3>>(&mut self, context: &Context<S>) -> Result<(), RemeshError> {
-        // Where a new vertex is safe: on the straight edge, inside the old triangles.
-        let mut safe = self.pos.clone();
+        let first_new = self.pos.len() as u32;
+        // Where each new vertex is safe: the midpoint of its edge's safe ends, which lies in
+        // the plane of an old triangle (the surface before splitting did not cross itself).
+        let mut safe: Vec<[f64; 3]> = Vec::new();
+        let mut candidates = self.edges();
         for _ in 0..16 {
-            let mut split = 0;
-            for [a, b] in self.edges() {
-                let mid = self.midpoint(a, b);
-                if self.length(a, b) > 4.0 / 3.0 * context.size(mid)? && self.split(a, b, &context.projector) {
-                    safe.push(mid);
-                    split += 1;
+            let mut created = Vec::new();
+            for [a, b] in candidates {
+                if self.length(a, b) > 4.0 / 3.0 * self.edge_size(a, b)
+                    && let Some(m) = self.split(a, b, context)?
+                {
+                    let safe_of = |v: u32| if v < first_new { self.pos[v as usize] } else { safe[(v - first_new) as usize] };
+                    let (p, q) = (safe_of(a), safe_of(b));
+                    safe.push([0, 1, 2].map(|k| 0.5 * (p[k] + q[k])));
+                    created.push(m);
                 }
             }
             let cap = context.params.max_triangles;
-            if self.num_triangles() > cap {
+            if self.live_triangles > cap {
                 return Err(RemeshError::TooManyTriangles { cap });
             }
-            if split == 0 {
+            if created.is_empty() {
                 break;
             }
+            candidates = created.iter().flat_map(|&m| self.neighbours(m).into_iter().map(move |x| [m, x])).collect();
         }
-        self.untangle(&safe);
+        let moved: Vec<u32> = (first_new..self.pos.len() as u32).collect();
+        let safe_of = |v: u32| if v < first_new { self.pos[v as usize] } else { safe[(v - first_new) as usize] };
+        let safe_positions: Vec<[f64; 3]> = moved.iter().map(|&v| safe_of(v)).collect();
+        self.untangle(&moved, |v| safe_positions[(v - first_new) as usize], &context.projector);
         Ok(())
     }
 
     /// Inserts the midpoint of edge (a, b), projected onto the reference, and splits both
-    /// triangles of the edge in two. Refuses (returns false) when the projection moves the
+    /// triangles of the edge in two. Refuses (returns `None`) when the projection moves the
     /// midpoint by more than a quarter of the edge: such an edge does not follow its face and
-    /// splitting it would not shorten it.
-    fn split(&mut self, a: u32, b: u32, projector: &Projector) -> bool {
-        let Some([t1, t2]) = self.edge_triangles(a, b) else { return false };
+    /// splitting it would not shorten it. Keeps the straight midpoint when the projected one
+    /// would turn a new triangle over.
+    fn split<S: SizingField<3>>(&mut self, a: u32, b: u32, context: &Context<S>) -> Result<Option<u32>, RemeshError> {
+        let Some([t1, t2]) = self.edge_triangles(a, b) else { return Ok(None) };
         let kind = self.edge_kind(t1, t2);
-        let mid = self.midpoint(a, b);
-        let projected = projector.project(mid, kind);
+        let (p, q) = (self.pos[a as usize], self.pos[b as usize]);
+        let mid = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
+        let projected = context.projector.project(mid, kind);
         if norm(sub(projected, mid)) > 0.25 * self.length(a, b) {
-            return false;
+            return Ok(None);
         }
-        let m = self.pos.len() as u32;
-        self.pos.push(projected);
-        self.kind.push(kind);
-        self.vertex_alive.push(true);
-        self.around.push(Vec::with_capacity(6));
-        for t in [t1, t2] {
+        let halves = [t1, t2].map(|t| {
             let tri = self.triangles[t as usize];
             let k = (0..3).find(|&k| [a, b].contains(&tri[k]) && [a, b].contains(&tri[(k + 1) % 3])).unwrap_or(0);
-            let (x, y, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            (t, tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3])
+        });
+        let keeps_side = halves.iter().all(|&(t, x, y, c)| {
+            let old = self.normal(self.triangles[t as usize]);
+            let [px, py, pc] = [x, y, c].map(|v| self.pos[v as usize]);
+            dot(cross(sub(projected, px), sub(pc, px)), old) > 0.0 && dot(cross(sub(py, projected), sub(pc, projected)), old) > 0.0
+        });
+        let at = if keeps_side { projected } else { mid };
+        let m = self.pos.len() as u32;
+        self.pos.push(at);
+        self.kind.push(kind);
+        self.h.push(context.size(at)?);
+        self.sized_at.push(at);
+        self.vertex_alive.push(true);
+        self.around.push(Vec::with_capacity(6));
+        for (t, x, y, c) in halves {
             let new = self.triangles.len() as u32;
             self.triangles[t as usize] = [x, m, c];
             self.triangles.push([m, y, c]);
@@ -354,7 +420,8 @@ impl WorkMesh {
             self.around[c as usize].push(new);
             self.around[m as usize].extend([t, new]);
         }
-        true
+        self.live_triangles += 2;
+        Ok(Some(m))
     }
 
     /// A new vertex on edge t1 ∩ t2 lies on their CAD face, or on the curve between their faces.
@@ -363,24 +430,22 @@ impl WorkMesh {
         if f == g { Kind::Face(f) } else { Kind::Curve(f.min(g), f.max(g)) }
     }
 
-    /// Collapses edges shorter than 4/5 of the size, shortest first, where allowed.
-    fn collapse_short_edges<S: SizingField<3>>(&mut self, context: &Context<S>) -> Result<(), RemeshError> {
-        let mut short = Vec::new();
-        for [a, b] in self.edges() {
-            let length = self.length(a, b);
-            if length < 0.8 * context.size(self.midpoint(a, b))? {
-                short.push((length, a, b));
-            }
-        }
+    /// Collapses edges shorter than 4/5 of their target, shortest first, where allowed.
+    fn collapse_short_edges<S: SizingField<3>>(&mut self, context: &Context<S>) {
+        let mut short: Vec<(f64, u32, u32)> = self
+            .edges()
+            .into_iter()
+            .map(|[a, b]| (self.length(a, b), a, b))
+            .filter(|&(length, a, b)| length < 0.8 * self.edge_size(a, b))
+            .collect();
         short.sort_by(|x, y| x.0.total_cmp(&y.0));
         let mut index = self.index();
         for (_, a, b) in short {
-            if !(self.vertex_alive[a as usize] && self.vertex_alive[b as usize]) || self.edge_triangles(a, b).is_none()
-            {
+            if !(self.vertex_alive[a as usize] && self.vertex_alive[b as usize]) {
                 continue;
             }
             for (from, to) in [(a, b), (b, a)] {
-                if self.collapse_allowed(from, to, context, &index)? {
+                if self.collapse_allowed(from, to, context, &index) {
                     for t in self.collapse(from, to) {
                         index.insert(t, self.triangle_box(t));
                     }
@@ -388,20 +453,13 @@ impl WorkMesh {
                 }
             }
         }
-        Ok(())
     }
 
     /// Whether vertex `from` may be merged into `to`: CAD structure kept, topology stays a
-    /// closed manifold (link condition), no triangle turns over, no new edge is too long or
-    /// strays from the reference.
-    fn collapse_allowed<S: SizingField<3>>(
-        &self,
-        from: u32,
-        to: u32,
-        context: &Context<S>,
-        index: &TriangleIndex,
-    ) -> Result<bool, RemeshError> {
-        let Some([t1, t2]) = self.edge_triangles(from, to) else { return Ok(false) };
+    /// closed manifold (link condition), no triangle turns over or degenerates, no new edge is
+    /// too long or strays from the reference, no new triangle crosses another.
+    fn collapse_allowed<S: SizingField<3>>(&self, from: u32, to: u32, context: &Context<S>, index: &TriangleIndex) -> bool {
+        let Some([t1, t2]) = self.edge_triangles(from, to) else { return false };
         let structure_kept = match self.kind[from as usize] {
             Kind::Corner => false,
             Kind::Face(_) => true,
@@ -411,40 +469,42 @@ impl WorkMesh {
             }
         };
         if !structure_kept {
-            return Ok(false);
+            return false;
         }
         let (n_from, n_to) = (self.neighbours(from), self.neighbours(to));
         let common = n_from.iter().filter(|v| n_to.binary_search(v).is_ok()).count();
         if common != 2 || n_from.len() <= 3 || n_to.len() <= 3 {
-            return Ok(false);
+            return false;
         }
         let target = self.pos[to as usize];
-        for &x in n_from.iter().filter(|&&x| x != to && n_to.binary_search(&x).is_err()) {
-            let p = self.pos[x as usize];
-            let Some([s, t]) = self.edge_triangles(from, x) else { return Ok(false) };
-            if norm(sub(p, target)) > 4.0 / 3.0 * context.size([0, 1, 2].map(|k| 0.5 * (p[k] + target[k])))?
-                || !context.follows_reference(target, p, self.edge_kind(s, t))?
-            {
-                return Ok(false);
+        let moved: Vec<(u32, [u32; 3])> = self.around[from as usize]
+            .iter()
+            .map(|&t| (t, self.triangles[t as usize]))
+            .filter(|(_, tri)| !tri.contains(&to))
+            .map(|(t, tri)| (t, tri.map(|v| if v == from { to } else { v })))
+            .collect();
+        let new_edges: Vec<u32> = n_from.iter().copied().filter(|&x| x != to && n_to.binary_search(&x).is_err()).collect();
+        // Cheap checks first: lengths, orientation and shape.
+        if new_edges.iter().any(|&x| self.length(x, to) > 4.0 / 3.0 * self.edge_size(x, to)) {
+            return false;
+        }
+        for &(t, new) in &moved {
+            let old = self.triangles[t as usize];
+            let q = self.quality(new);
+            if dot(self.normal(old), self.normal(new)) <= 0.0 || (q < MIN_QUALITY && q < self.quality(old)) {
+                return false;
             }
         }
-        for &t in &self.around[from as usize] {
-            let tri = self.triangles[t as usize];
-            if tri.contains(&to) {
-                continue;
-            }
-            let old = self.normal(tri);
-            let new = self.normal(tri.map(|v| if v == from { to } else { v }));
-            // The moved triangle must keep its side, not become a needle and not cross another.
-            let moved = tri.map(|v| if v == from { to } else { v });
-            if dot(old, new) <= 0.0
-                || norm(new) < 1e-3 * norm(old).max(f64::MIN_POSITIVE)
-                || self.crosses(index, moved, &self.around[from as usize])
-            {
-                return Ok(false);
+        for &x in &new_edges {
+            let Some([s, t]) = self.edge_triangles(from, x) else { return false };
+            if !context.follows_reference(target, self.pos[x as usize], self.edge_kind(s, t), self.edge_size(x, to)) {
+                return false;
             }
         }
-        Ok(true)
+        // Inside planar faces, triangles that keep their orientation cannot cross anything.
+        let around = &self.around[from as usize];
+        around.iter().all(|&t| context.projector.is_planar(self.face[t as usize]))
+            || !moved.iter().any(|&(_, new)| self.crosses(index, new, around))
     }
 
     /// Merges `from` into `to`; returns the triangles that changed corners.
@@ -454,6 +514,7 @@ impl WorkMesh {
             let tri = self.triangles[t as usize];
             if tri.contains(&to) {
                 self.triangle_alive[t as usize] = false;
+                self.live_triangles -= 1;
                 for v in tri.into_iter().filter(|&v| v != from) {
                     self.around[v as usize].retain(|&s| s != t);
                 }
@@ -467,8 +528,9 @@ impl WorkMesh {
         moved
     }
 
-    /// Flips edges inside a CAD face when that brings the four vertices closer to valence 6.
-    fn flip_toward_valence_six<S: SizingField<3>>(&mut self, context: &Context<S>) -> Result<(), RemeshError> {
+    /// Flips edges inside a CAD face that bring the four vertices closer to valence 6 without
+    /// making the worst of the two triangles much worse, or that make it clearly better.
+    fn flip_edges<S: SizingField<3>>(&mut self, context: &Context<S>) {
         let mut index = self.index();
         for [a, b] in self.edges() {
             let Some([t1, t2]) = self.edge_triangles(a, b) else { continue };
@@ -476,14 +538,14 @@ impl WorkMesh {
                 continue;
             }
             let (c, d) = (self.apex(t1, a, b), self.apex(t2, a, b));
-            if c == d || self.neighbours(c).binary_search(&d).is_ok() {
+            if c == d || self.around[c as usize].iter().any(|&t| self.triangles[t as usize].contains(&d)) {
                 continue;
             }
             let valence = |v: u32| self.around[v as usize].len() as i64;
             let deviation =
                 |va: i64, vb: i64, vc: i64, vd: i64| [va, vb, vc, vd].iter().map(|v| (v - 6) * (v - 6)).sum::<i64>();
             let (va, vb, vc, vd) = (valence(a), valence(b), valence(c), valence(d));
-            if va <= 3 || vb <= 3 || deviation(va - 1, vb - 1, vc + 1, vd + 1) >= deviation(va, vb, vc, vd) {
+            if va <= 3 || vb <= 3 {
                 continue;
             }
             // Orient so that t1 = (x, y, c) runs x → y; then t2 runs y → x with apex d.
@@ -491,15 +553,21 @@ impl WorkMesh {
             let k = (0..3).find(|&k| tri[(k + 2) % 3] == c).unwrap_or(0);
             let (x, y) = (tri[k], tri[(k + 1) % 3]);
             let (new1, new2) = ([x, d, c], [y, c, d]);
+            let old_quality = self.quality(self.triangles[t1 as usize]).min(self.quality(self.triangles[t2 as usize]));
+            let new_quality = self.quality(new1).min(self.quality(new2));
+            let better_valence = deviation(va - 1, vb - 1, vc + 1, vd + 1) < deviation(va, vb, vc, vd);
+            if !(better_valence && new_quality >= 0.9 * old_quality || new_quality >= 1.25 * old_quality) {
+                continue;
+            }
             let old = add(self.normal(self.triangles[t1 as usize]), self.normal(self.triangles[t2 as usize]));
             let (n1, n2) = (self.normal(new1), self.normal(new2));
             if dot(n1, old) <= 0.0 || dot(n2, old) <= 0.0 || dot(n1, n2) <= 0.0 {
                 continue;
             }
             let kind = Kind::Face(self.face[t1 as usize]);
-            if !context.follows_reference(self.pos[c as usize], self.pos[d as usize], kind)?
-                || self.crosses(&index, new1, &[t1, t2])
-                || self.crosses(&index, new2, &[t1, t2])
+            let curved = !context.projector.is_planar(self.face[t1 as usize]);
+            if !context.follows_reference(self.pos[c as usize], self.pos[d as usize], kind, self.edge_size(c, d))
+                || curved && (self.crosses(&index, new1, &[t1, t2]) || self.crosses(&index, new2, &[t1, t2]))
             {
                 continue;
             }
@@ -512,53 +580,71 @@ impl WorkMesh {
             index.insert(t1, self.triangle_box(t1));
             index.insert(t2, self.triangle_box(t2));
         }
-        Ok(())
     }
 
-    /// One Jacobi pass of tangential smoothing (face vertices toward the centroid of their
-    /// neighbours within the tangent plane, curve vertices toward the mean of their two curve
-    /// neighbours), each result projected onto its own face or curve of the reference.
-    fn smooth_and_project(&mut self, projector: &Projector) {
+    /// One Gauss–Seidel pass of tangential smoothing (face vertices toward the centroid of
+    /// their neighbours within the tangent plane, curve vertices toward the mean of their two
+    /// curve neighbours), each result projected onto its own face or curve of the reference.
+    /// A move that would turn a triangle over or degenerate it is skipped; the sizes of moved
+    /// vertices are re-evaluated.
+    fn smooth_and_project<S: SizingField<3>>(&mut self, context: &Context<S>) -> Result<(), RemeshError> {
         let safe = self.pos.clone();
-        let moved: Vec<[f64; 3]> = (0..self.pos.len() as u32)
-            .map(|v| {
-                let p = self.pos[v as usize];
-                let kind = self.kind[v as usize];
-                if !self.vertex_alive[v as usize] || kind == Kind::Corner {
-                    return p;
+        let mut moved = Vec::new();
+        for v in 0..self.pos.len() as u32 {
+            let p = self.pos[v as usize];
+            let kind = self.kind[v as usize];
+            if !self.vertex_alive[v as usize] || kind == Kind::Corner {
+                continue;
+            }
+            let neighbours: Vec<u32> = self
+                .neighbours(v)
+                .into_iter()
+                .filter(|&x| {
+                    matches!(kind, Kind::Face(_))
+                        || self.edge_triangles(v, x).is_some_and(|[s, t]| self.face[s as usize] != self.face[t as usize])
+                })
+                .collect();
+            if neighbours.is_empty() {
+                continue;
+            }
+            let centroid = neighbours
+                .iter()
+                .fold([0.0; 3], |acc, &x| add(acc, self.pos[x as usize]))
+                .map(|c| c / neighbours.len() as f64);
+            let mut step = sub(centroid, p);
+            let around = &self.around[v as usize];
+            if let Kind::Face(_) = kind {
+                let n = around.iter().fold([0.0; 3], |acc, &t| add(acc, self.normal(self.triangles[t as usize])));
+                let nn = dot(n, n);
+                if nn > 0.0 {
+                    step = axpy(step, -dot(step, n) / nn, n);
                 }
-                let neighbours: Vec<u32> = self
-                    .neighbours(v)
-                    .into_iter()
-                    .filter(|&x| {
-                        matches!(kind, Kind::Face(_))
-                            || self
-                                .edge_triangles(v, x)
-                                .is_some_and(|[s, t]| self.face[s as usize] != self.face[t as usize])
-                    })
-                    .collect();
-                if neighbours.is_empty() {
-                    return p;
-                }
-                let centroid = neighbours
-                    .iter()
-                    .fold([0.0; 3], |acc, &x| add(acc, self.pos[x as usize]))
-                    .map(|c| c / neighbours.len() as f64);
-                let mut step = sub(centroid, p);
-                if let Kind::Face(_) = kind {
-                    let n = self.around[v as usize]
-                        .iter()
-                        .fold([0.0; 3], |acc, &t| add(acc, self.normal(self.triangles[t as usize])));
-                    let nn = dot(n, n);
-                    if nn > 0.0 {
-                        step = axpy(step, -dot(step, n) / nn, n);
-                    }
-                }
-                projector.project(add(p, step), kind)
-            })
-            .collect();
-        self.pos = moved;
-        self.untangle(&safe);
+            }
+            let target = context.projector.project(add(p, step), kind);
+            let before: Vec<([f64; 3], f64)> =
+                around.iter().map(|&t| (self.normal(self.triangles[t as usize]), self.quality(self.triangles[t as usize]))).collect();
+            self.pos[v as usize] = target;
+            let acceptable = around.iter().zip(&before).all(|(&t, &(normal, q))| {
+                let tri = self.triangles[t as usize];
+                let q_new = self.quality(tri);
+                dot(self.normal(tri), normal) > 0.0 && (q_new >= MIN_QUALITY || q_new >= q)
+            });
+            if acceptable {
+                moved.push(v);
+            } else {
+                self.pos[v as usize] = p;
+            }
+        }
+        self.untangle(&moved, |v| safe[v as usize], &context.projector);
+        // Sizes follow their vertex once it has moved by a tenth of its size.
+        for v in moved {
+            let p = self.pos[v as usize];
+            if norm(sub(p, self.sized_at[v as usize])) > 0.1 * self.h[v as usize] {
+                self.h[v as usize] = context.size(p)?;
+                self.sized_at[v as usize] = p;
+            }
+        }
+        Ok(())
     }
 
     fn triangle_box(&self, t: u32) -> AABB<[f64; 3]> {
@@ -586,23 +672,45 @@ impl WorkMesh {
         })
     }
 
-    /// Sends the vertices of crossing triangles back to their `safe` positions (where the
-    /// surface did not cross itself), for a few rounds since a move back can expose another.
-    fn untangle(&mut self, safe: &[[f64; 3]]) {
-        for _ in 0..4 {
-            let live: Vec<[u32; 3]> =
-                (0..self.triangles.len()).filter(|&t| self.triangle_alive[t]).map(|t| self.triangles[t]).collect();
-            let mut moved_back = false;
-            for (t, u) in intersecting_pairs(&self.pos, &live) {
-                for &v in live[t].iter().chain(&live[u]) {
-                    if self.pos[v as usize] != safe[v as usize] {
-                        self.pos[v as usize] = safe[v as usize];
-                        moved_back = true;
+    /// Sends `moved` vertices of crossing triangles back to their `safe` positions (where the
+    /// surface did not cross itself), repeating around the vertices sent back since a move
+    /// back can expose another crossing. Only triangles around moved vertices are checked, and
+    /// only against triangles they share no corner with (moves were checked against turning
+    /// their own triangles over), and only on curved faces (inside a planar face, triangles
+    /// that keep their orientation cannot cross anything).
+    fn untangle(&mut self, moved: &[u32], safe: impl Fn(u32) -> [f64; 3], projector: &Projector) {
+        let mut index = self.index();
+        let mut is_moved = vec![false; self.pos.len()];
+        moved.iter().for_each(|&v| is_moved[v as usize] = true);
+        let mut check: Vec<u32> = moved.iter().flat_map(|&v| self.around[v as usize].iter().copied()).collect();
+        while !check.is_empty() {
+            check.retain(|&t| !projector.is_planar(self.face[t as usize]));
+            check.sort_unstable();
+            check.dedup();
+            let mut back = Vec::new();
+            for &t in &check {
+                let tri = self.triangles[t as usize];
+                let corners = tri.map(|v| self.pos[v as usize]);
+                for u in index.candidates(triangle_box(&corners)) {
+                    let other = self.triangles[u as usize];
+                    if self.triangle_alive[u as usize]
+                        && !other.iter().any(|v| tri.contains(v))
+                        && triangles_intersect(&corners, &other.map(|v| self.pos[v as usize]))
+                    {
+                        back.extend(tri.iter().chain(&other).copied().filter(|&v| is_moved[v as usize]));
                     }
                 }
             }
-            if !moved_back {
-                return;
+            check.clear();
+            for v in back {
+                if is_moved[v as usize] {
+                    is_moved[v as usize] = false;
+                    self.pos[v as usize] = safe(v);
+                    for &t in &self.around[v as usize] {
+                        index.insert(t, self.triangle_box(t));
+                        check.push(t);
+                    }
+                }
             }
         }
     }
@@ -622,6 +730,13 @@ impl WorkMesh {
         let face_ids = live.map(|t| self.face[t]).collect();
         Surface::new(vertices, triangles, face_ids)
     }
+}
+
+/// 4√3·area / Σ edge²: 1 for an equilateral triangle, 0 for a degenerate one.
+fn quality([a, b, c]: [[f64; 3]; 3]) -> f64 {
+    let squared = |p: [f64; 3], q: [f64; 3]| dot(sub(p, q), sub(p, q));
+    let sum = squared(a, b) + squared(b, c) + squared(c, a);
+    if sum > 0.0 { 2.0 * 3f64.sqrt() * norm(cross(sub(b, a), sub(c, a))) / sum } else { 0.0 }
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

@@ -16,12 +16,21 @@ use super::tetgen::Plc;
 
 /// A triangle surface: vertices, triangles (zero-based vertex indices) and the CAD face id of
 /// every triangle. Indices are in range and vertices finite ([`Surface::new`] checks); whether
-/// the surface bounds a solid is what [`Surface::validate`] checks.
-#[derive(Clone, Debug, PartialEq)]
+/// the surface bounds a solid is what [`Surface::validate`] checks (and remembers).
+#[derive(Clone, Debug)]
 pub struct Surface {
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
     face_ids: Vec<i32>,
+    /// Whether [`Surface::validate`] succeeded (nothing can change the surface afterwards).
+    valid: bool,
+}
+
+impl PartialEq for Surface {
+    /// Same vertices, triangles and face ids (validated or not).
+    fn eq(&self, other: &Self) -> bool {
+        (&self.vertices, &self.triangles, &self.face_ids) == (&other.vertices, &other.triangles, &other.face_ids)
+    }
 }
 
 /// Where the CAD face ids of an STL file come from.
@@ -148,7 +157,7 @@ impl Surface {
                 });
             }
         }
-        Ok(Self { vertices, triangles, face_ids })
+        Ok(Self { vertices, triangles, face_ids, valid: false })
     }
 
     /// Builds a surface from a triangle soup (3 corners per triangle, as in STL), merging
@@ -206,6 +215,11 @@ impl Surface {
         Ok((surface, report))
     }
 
+    /// Whether [`Surface::validate`] has succeeded on this surface.
+    pub fn is_validated(&self) -> bool {
+        self.valid
+    }
+
     /// Vertex positions.
     pub fn vertices(&self) -> &[[f64; 3]] {
         &self.vertices
@@ -247,6 +261,7 @@ impl Surface {
             return Err(SurfaceDefect::SelfIntersection { first, first_face, second, second_face, at });
         }
         let euler_characteristic = self.vertices.len() as i64 - edges.len() as i64 + self.triangles.len() as i64;
+        self.valid = true;
         Ok(SurfaceReport {
             components,
             flipped_triangles,

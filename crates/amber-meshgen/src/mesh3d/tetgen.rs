@@ -57,6 +57,8 @@ pub struct TetgenSwitches {
     pub keep_boundary: bool,
     /// `-O`/`-o`: optimisation, or TetGen's default.
     pub optimization: Option<Optimization>,
+    /// `-S`: stop inserting points after this many Steiner points (none: no limit).
+    pub max_steiner_points: Option<usize>,
 }
 
 impl Default for TetgenSwitches {
@@ -66,6 +68,7 @@ impl Default for TetgenSwitches {
             quality: Some(Quality { max_radius_edge_ratio: 1.4, min_dihedral_deg: 20.0 }),
             keep_boundary: true,
             optimization: Some(Optimization { level: 7, scheme: 7, max_dihedral_deg: 150.0 }),
+            max_steiner_points: None,
         }
     }
 }
@@ -77,6 +80,7 @@ impl TetgenSwitches {
             quality: Some(Quality { max_radius_edge_ratio, min_dihedral_deg: 0.0 }),
             keep_boundary: false,
             optimization: None,
+            max_steiner_points: None,
         }
     }
 
@@ -101,6 +105,10 @@ impl TetgenSwitches {
                 return Err(TetgenError::InvalidSwitches(format!("{o:?}")));
             }
             s += &format!("O{}/{}o/{}", o.level, o.scheme, o.max_dihedral_deg);
+        }
+        if let Some(n) = self.max_steiner_points {
+            // TetGen reads the count into an `int`; 0 would mean "no limit".
+            s += &format!("S{}", n.clamp(1, i32::MAX as usize));
         }
         s.push('Q');
         Ok(s)
@@ -470,6 +478,8 @@ mod tests {
         assert_eq!(s.to_command(true).unwrap(), "pYq1.4/20mO7/7o/150Q");
         assert_eq!(s.to_command(false).unwrap(), "pYq1.4/20O7/7o/150Q");
         assert_eq!(TetgenSwitches::plain_quality(1.4).to_command(false).unwrap(), "pq1.4/0Q");
+        let capped = TetgenSwitches { max_steiner_points: Some(5000), ..s };
+        assert_eq!(capped.to_command(true).unwrap(), "pYq1.4/20mO7/7o/150S5000Q");
         let bad =
             TetgenSwitches { optimization: Some(Optimization { level: 12, scheme: 7, max_dihedral_deg: 150.0 }), ..s };
         assert!(matches!(bad.to_command(true), Err(TetgenError::InvalidSwitches(_))));

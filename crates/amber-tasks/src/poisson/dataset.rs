@@ -234,6 +234,44 @@ pub fn write_split(
     }
 }
 
+/// Where a split lives under the Poisson data root: `<root>/<difficulty>/<split>`, training
+/// splits under `<root>/<difficulty>/train/seed<r>` (one per training seed).
+pub fn split_dir(root: &Path, difficulty: Difficulty, split: Split, training_seed: usize) -> PathBuf {
+    let dir = root.join(difficulty.name()).join(split.name());
+    match split {
+        Split::Train => dir.join(format!("seed{training_seed}")),
+        Split::Val | Split::Test => dir,
+    }
+}
+
+/// The first `count` problems (default: the manifest's split size) of a split, generated into
+/// [`split_dir`] first where the cache does not already hold them. `on_problem` ticks once per
+/// problem generated or found cached.
+pub fn load_split(
+    root: &Path,
+    manifest_path: &Path,
+    difficulty: Difficulty,
+    split: Split,
+    training_seed: usize,
+    count: Option<usize>,
+    on_problem: &(dyn Fn() + Sync),
+) -> Result<(Vec<PoissonProblem>, SplitReport), TaskError> {
+    let manifest = DatasetManifest::read(manifest_path)?;
+    let (split_seed, size) = manifest.split(split, training_seed, manifest_path)?;
+    let request = SplitRequest {
+        difficulty,
+        split_seed,
+        count: count.unwrap_or(size),
+        initial_size: super::INITIAL_SIZE,
+        heuristic: ExpertHeuristic::default(),
+    };
+    let dir = split_dir(root, difficulty, split, training_seed);
+    let report = write_split(&request, &dir, on_problem)?;
+    let mut problems = super::read_split(&dir)?;
+    problems.truncate(request.count);
+    Ok((problems, report))
+}
+
 fn inputs_hash(request: &SplitRequest, seed: u64) -> String {
     let inputs = serde_json::json!({
         "version": GENERATOR_VERSION,

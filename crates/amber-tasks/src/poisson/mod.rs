@@ -3,7 +3,9 @@
 mod dataset;
 mod file;
 
-pub use dataset::{DatasetManifest, Split, SplitReport, SplitRequest, problem_seeds, write_split};
+pub use dataset::{
+    DatasetManifest, Split, SplitReport, SplitRequest, load_split, problem_seeds, split_dir, write_split,
+};
 pub use file::{read_problem, read_split};
 
 use std::fmt;

@@ -1,0 +1,20 @@
+//! The U-Net CNN baseline of AMBER (spec §8): per-element features of an auxiliary mesh and an
+//! inside/outside mask rasterised onto a pixel (2D) or voxel (3D) grid over the geometry's
+//! bounding box ([`PixelGrid`]), a candle U-Net for both dimensions ([`UNet`]) built on this
+//! crate's own convolution, transposed convolution, max-pooling and fused BatchNorm+ReLU ops
+//! (candle has no 3D ops, a wrong `max_pool2d` backward and norms that drop gradients), the
+//! losses of the paper and its ablations ([`CnnLoss`]), and model files (safetensors + JSON).
+//!
+//! This crate sees meshes only to rasterise them and knows nothing of FEM, mesh generation, the
+//! training loop or metrics: those live in `amber-train`, which drives it.
+
+mod error;
+mod loss;
+pub mod ops;
+mod raster;
+mod unet;
+
+pub use error::{CnnError, Result};
+pub use loss::CnnLoss;
+pub use raster::{PixelGrid, Raster};
+pub use unet::{UNet, UNetConfig};

@@ -1,0 +1,109 @@
+//! Strided matrix products on raw buffers (the `gemm` crate candle itself uses), and the work
+//! split the convolutions share: many small single-threaded products in parallel when there are
+//! enough tiles, else one multi-threaded product per tile.
+
+use rayon::prelude::*;
+
+use super::Float;
+
+/// A strided matrix view: element (i, j) lives at `ptr + i·rows + j·cols`.
+#[derive(Clone, Copy)]
+pub(super) struct Strided<T> {
+    pub ptr: *const T,
+    pub rows: isize,
+    pub cols: isize,
+}
+
+impl<T> Strided<T> {
+    /// A row-major matrix with `cols` columns.
+    pub fn row_major(data: &[T], cols: usize) -> Self {
+        Self { ptr: data.as_ptr(), rows: cols as isize, cols: 1 }
+    }
+
+    /// The transpose of a row-major matrix with `cols` columns.
+    pub fn transposed(data: &[T], cols: usize) -> Self {
+        Self { ptr: data.as_ptr(), rows: 1, cols: cols as isize }
+    }
+}
+
+/// `dst (m×n) = [dst +] a (m×k) · b (k×n)`; `dst` row-major with row stride `dst_rows`.
+///
+/// # Safety
+/// Every element the strides address must lie inside live buffers, and no other thread may
+/// touch the addressed part of `dst` meanwhile.
+#[allow(clippy::too_many_arguments)]
+pub(super) unsafe fn matmul<T: Float>(
+    m: usize,
+    n: usize,
+    k: usize,
+    dst: *mut T,
+    dst_rows: usize,
+    accumulate: bool,
+    a: Strided<T>,
+    b: Strided<T>,
+    threads: usize,
+) {
+    if m == 0 || n == 0 {
+        return;
+    }
+    let parallelism = if threads > 1 { gemm::Parallelism::Rayon(threads) } else { gemm::Parallelism::None };
+    // SAFETY: forwarded to the caller.
+    unsafe {
+        gemm::gemm(
+            m,
+            n,
+            k,
+            dst,
+            1,
+            dst_rows as isize,
+            accumulate,
+            a.ptr,
+            a.cols,
+            a.rows,
+            b.ptr,
+            b.cols,
+            b.rows,
+            T::from_f64(1.0),
+            T::from_f64(1.0),
+            false,
+            false,
+            false,
+            parallelism,
+        )
+    }
+}
+
+/// Runs `work(item, threads_for_its_matmuls)` for every item: items in parallel with
+/// single-threaded products when there are enough of them to keep every thread busy, else one
+/// after the other with multi-threaded products (the deep, small levels of a U-Net).
+pub(super) fn for_each_item(items: usize, work: impl Fn(usize, usize) + Sync) {
+    let threads = rayon::current_num_threads();
+    if items >= 2 * threads {
+        (0..items).into_par_iter().for_each(|i| work(i, 1));
+    } else {
+        (0..items).for_each(|i| work(i, threads));
+    }
+}
+
+/// Like [`for_each_item`], but every item adds into an accumulator of `len` zeros; returns the
+/// sum of all accumulators.
+pub(super) fn sum_over_items<T: Float>(items: usize, len: usize, work: impl Fn(usize, usize, &mut [T]) + Sync) -> Vec<T> {
+    let threads = rayon::current_num_threads();
+    let zeros = || vec![T::zero(); len];
+    if items >= 2 * threads {
+        (0..items)
+            .into_par_iter()
+            .fold(zeros, |mut acc, i| {
+                work(i, 1, &mut acc);
+                acc
+            })
+            .reduce(zeros, |mut a, b| {
+                a.iter_mut().zip(&b).for_each(|(a, &b)| *a += b);
+                a
+            })
+    } else {
+        let mut acc = zeros();
+        (0..items).for_each(|i| work(i, threads, &mut acc));
+        acc
+    }
+}

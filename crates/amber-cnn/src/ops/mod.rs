@@ -1,0 +1,88 @@
+//! The U-Net's CPU ops that candle lacks or gets wrong, each a custom op with a hand-written
+//! backward and generic over the number of spatial axes (2D images, 3D voxel grids):
+//! [`conv`] (odd kernel, "same" padding), [`conv_transpose2`] (kernel 2, stride 2),
+//! [`max_pool2`] (candle's `max_pool2d` backward is wrong) and [`batch_norm_relu`] (candle-nn's
+//! norms are not all differentiable, and fusing the ReLU saves two passes).
+//!
+//! Tensors are channel-major, `(N, C, spatial...)`. The convolutions are tiled im2col + gemm:
+//! each work item unfolds a block of rows of one image into a small scratch matrix and
+//! multiplies it straight into the output, so no image-sized unfolded copy ever exists.
+
+mod batch_norm;
+mod conv;
+mod conv_transpose;
+mod gemm;
+mod pool;
+
+pub use batch_norm::{BatchNormStats, batch_norm_relu};
+pub use conv::conv;
+pub use conv_transpose::conv_transpose2;
+pub use pool::max_pool2;
+
+use candle_core::{CpuStorage, DType, Layout, Result, Storage, Tensor, WithDType, bail};
+
+/// The float types the ops run on: f32 for training, f64 for gradient checks.
+pub(crate) trait Float: WithDType {}
+
+impl Float for f32 {}
+impl Float for f64 {}
+
+/// The contiguous data of a CPU storage.
+fn cpu_slice<'a, T: Float>(s: &'a CpuStorage, l: &Layout) -> Result<&'a [T]> {
+    match l.contiguous_offsets() {
+        Some((start, end)) => Ok(&s.as_slice::<T>()?[start..end]),
+        None => bail!("amber-cnn ops need contiguous inputs"),
+    }
+}
+
+/// The contiguous data of a tensor's storage.
+fn storage_slice<'a, T: Float>(storage: &'a Storage, l: &Layout) -> Result<&'a [T]> {
+    match storage {
+        Storage::Cpu(s) => cpu_slice(s, l),
+        _ => bail!("amber-cnn ops run on the CPU only"),
+    }
+}
+
+/// Runs `f` on the contiguous data of `t`.
+fn with_slice<T: Float, R>(t: &Tensor, f: impl FnOnce(&[T]) -> Result<R>) -> Result<R> {
+    let t = t.contiguous()?;
+    let (storage, layout) = t.storage_and_layout();
+    f(storage_slice(&storage, layout)?)
+}
+
+/// The common float dtype of an op's inputs.
+fn float_dtype(op: &str, dtypes: &[DType]) -> Result<DType> {
+    match dtypes {
+        [first, rest @ ..] if matches!(first, DType::F32 | DType::F64) && rest.iter().all(|d| d == first) => {
+            Ok(*first)
+        }
+        _ => bail!("{op}: inputs must be all f32 or all f64, got {dtypes:?}"),
+    }
+}
+
+/// `(N, C, spatial...)` of a channel-major tensor with `spatial_axes` spatial axes.
+fn image_dims(op: &str, dims: &[usize], spatial_axes: usize) -> Result<(usize, usize, Vec<usize>)> {
+    if dims.len() != spatial_axes + 2 || spatial_axes == 0 || dims[2..].contains(&0) {
+        bail!("{op}: expected a (N, C, {spatial_axes} non-empty spatial axes) tensor, got shape {dims:?}");
+    }
+    Ok((dims[0], dims[1], dims[2..].to_vec()))
+}
+
+/// A raw pointer that work items running in parallel write through, each into its own disjoint
+/// part of the buffer.
+#[derive(Clone, Copy)]
+struct SharedMut<T>(*mut T);
+
+// SAFETY: every user writes disjoint index ranges from different threads (checked at each use).
+unsafe impl<T: Send> Send for SharedMut<T> {}
+unsafe impl<T: Send> Sync for SharedMut<T> {}
+
+impl<T> SharedMut<T> {
+    /// The pointer (a method, so that closures capture the `Sync` wrapper, not the raw field).
+    fn ptr(self) -> *mut T {
+        self.0
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod testing;

@@ -1,0 +1,23 @@
+//! The paper's experiments as library functions, shared by `cargo xtask` and the `amber`
+//! command: methods and their variants as configurations of one code path ([`MethodSpec`]), a
+//! run directory per (method, variant, difficulty, seed) keyed by a hash of its whole
+//! configuration (trained models are reused, killed runs resume), evaluation on the test
+//! problems with the paper's metrics, and the outputs every experiment writes: `results.json`
+//! in one schema ([`ExperimentResults`]), `table.md` with the paper's numbers beside ours, and
+//! PNG charts and mesh galleries. Progress goes to the terminal as bars and lines.
+
+mod method;
+mod plots;
+mod poisson;
+mod progress;
+mod report;
+mod results;
+mod table;
+
+pub use method::{Method, MethodSpec, Variant};
+pub use plots::{Bar, Series, Tile, bar_chart, line_chart, mesh_gallery};
+pub use poisson::{PoissonExperiment, train_poisson};
+pub use progress::{TrainingProgress, item_bar};
+pub use report::{commit, config_hash, machine, merge_json, read_json, write_atomic, write_json};
+pub use results::{ExperimentResults, ProblemEvaluation, RunKey, RunResult, StepEvaluation};
+pub use table::{markdown as markdown_table, row_label};

@@ -1,0 +1,114 @@
+//! Progress of long work on the terminal: a bar per training run with the recent loss and
+//! throughput, and a line per validation and checkpoint (kept in the scrollback, so a log of
+//! the run's quality survives).
+
+use std::path::Path;
+use std::time::Instant;
+
+use amber_train::{EvaluationSummary, StepReport, TrainingObserver};
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// Steps between progress lines when no bar can be drawn.
+const LOG_INTERVAL: u64 = 100;
+
+/// Draws a training run's progress bar; `label` names the run in every line.
+pub struct TrainingProgress {
+    bar: ProgressBar,
+    label: String,
+    started: Instant,
+    window: Window,
+}
+
+/// Means over the steps since the bar's message was last refreshed.
+#[derive(Default)]
+struct Window {
+    steps: u64,
+    loss: f64,
+    nodes: usize,
+    seconds: f64,
+}
+
+impl TrainingProgress {
+    /// A bar for a run that stands at `done` of `total` steps.
+    pub fn new(label: &str, done: u64, total: u64) -> Self {
+        let bar = ProgressBar::new(total).with_style(
+            ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta}) {msg}")
+                .expect("a valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(label.to_string());
+        bar.set_position(done);
+        Self { bar, label: label.into(), started: Instant::now(), window: Window::default() }
+    }
+
+    /// Prints a line above the bar (to stderr when there is no terminal to draw the bar on).
+    pub fn println(&self, line: &str) {
+        let line = format!("{}: {line}", self.label);
+        if self.bar.is_hidden() { eprintln!("{line}") } else { self.bar.println(line) }
+    }
+
+    /// Removes the bar, leaving the printed lines.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+impl TrainingObserver for TrainingProgress {
+    fn step(&mut self, report: &StepReport, total: u64) {
+        let w = &mut self.window;
+        w.steps += 1;
+        w.loss += report.loss;
+        w.nodes += report.nodes;
+        w.seconds += report.seconds;
+        self.bar.set_position(report.step);
+        // Without a terminal (logs, CI) the bar is hidden: print a line every few hundred steps.
+        let every = if self.bar.is_hidden() { LOG_INTERVAL } else { 20 };
+        if w.steps >= every || report.step == total {
+            let message = format!(
+                "loss {:.4}, {:.0} nodes/s, buffer {:?}",
+                w.loss / w.steps as f64,
+                w.nodes as f64 / w.seconds.max(1e-9),
+                report.buffer_depths
+            );
+            self.window = Window::default();
+            if self.bar.is_hidden() {
+                self.println(&format!(
+                    "step {}/{total} ({:.0} s): {message}",
+                    report.step,
+                    self.started.elapsed().as_secs_f64()
+                ));
+            } else {
+                self.bar.set_message(message);
+            }
+        }
+    }
+
+    fn validation(&mut self, step: u64, s: &EvaluationSummary) {
+        let per_step: Vec<String> = s.steps.iter().map(|t| format!("{:.3}", t.normalised_dcd)).collect();
+        let last = s.steps.last();
+        self.println(&format!(
+            "validation at step {step} ({:.0} s): normalised DCD per generation step {} ({:.0} elements, expert \
+             {:.0}, {} failed)",
+            self.started.elapsed().as_secs_f64(),
+            per_step.join(", "),
+            last.map_or(0.0, |t| t.elements),
+            s.expert_elements,
+            last.map_or(0, |t| t.failed),
+        ));
+    }
+
+    fn checkpoint(&mut self, step: u64, dir: &Path) {
+        self.bar.set_message(format!("checkpoint at step {step}: {}", dir.display()));
+    }
+}
+
+/// A plain counting bar for work measured in items (dataset problems, rollouts).
+pub fn item_bar(label: &str, total: usize) -> ProgressBar {
+    let bar = ProgressBar::new(total as u64).with_style(
+        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_prefix(label.to_string());
+    bar
+}

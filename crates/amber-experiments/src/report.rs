@@ -1,0 +1,107 @@
+//! Writing results: atomic files, and the record of where numbers came from (commit, machine).
+
+use std::path::Path;
+
+use anyhow::Context;
+
+/// Writes pretty JSON to `path` atomically (temporary file in the same directory, then rename),
+/// creating parent directories.
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
+    write_atomic(path, text.as_bytes())
+}
+
+/// Reads a JSON file, naming it in errors.
+pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    serde_json::from_slice(&bytes).with_context(|| format!("{}: not the expected JSON", path.display()))
+}
+
+/// Writes bytes to `path` atomically, creating parent directories.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create directory", dir.display()))?;
+    }
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, bytes).with_context(|| format!("{}: cannot write", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot rename into place", path.display()))?;
+    Ok(())
+}
+
+/// CPU model, core count, memory and load average, for the record.
+pub fn machine() -> serde_json::Value {
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let cpu = cpuinfo
+        .lines()
+        .find_map(|l| l.strip_prefix("model name").map(|r| r.trim_start_matches([' ', '\t', ':']).to_string()));
+    let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
+    let mem_kb = meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemTotal:"))
+        .and_then(|r| r.trim().trim_end_matches(" kB").parse::<u64>().ok());
+    serde_json::json!({
+        "cpu": cpu,
+        "cores": std::thread::available_parallelism().map(|n| n.get()).ok(),
+        "threads": rayon::current_num_threads(),
+        "memory_gib": mem_kb.map(|kb| kb as f64 / 1048576.0),
+        "load_average": std::fs::read_to_string("/proc/loadavg").ok().map(|s| s.trim().to_string()),
+    })
+}
+
+/// The commit the running code was built from (`git rev-parse HEAD`, with `-dirty` when the
+/// tree has changes), or `None` outside a git checkout.
+pub fn commit() -> Option<String> {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    let head = git(&["rev-parse", "HEAD"])?;
+    let dirty = git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+    Some(if dirty { format!("{head}-dirty") } else { head })
+}
+
+/// Short hex SHA-256 of a JSON value's canonical text (object keys are sorted by serde_json's
+/// map), used to key cached runs by their full configuration.
+pub fn config_hash(value: &serde_json::Value) -> String {
+    use sha2::{Digest, Sha256};
+    let digest = Sha256::digest(value.to_string().as_bytes());
+    digest.iter().take(6).map(|b| format!("{b:02x}")).collect()
+}
+
+/// Overwrites fields of `base` with those of `overrides`, recursively for objects (a JSON merge
+/// patch without deletions): how variants and config files change a profile.
+pub fn merge_json(base: &mut serde_json::Value, overrides: &serde_json::Value) {
+    match (base, overrides) {
+        (serde_json::Value::Object(b), serde_json::Value::Object(o)) => {
+            for (k, v) in o {
+                merge_json(b.entry(k.clone()).or_insert(serde_json::Value::Null), v);
+            }
+        }
+        (b, o) => *b = o.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merge_overrides_nested_fields_only() {
+        let mut base = serde_json::json!({"a": 1, "n": {"x": 1, "y": 2}});
+        merge_json(&mut base, &serde_json::json!({"n": {"y": 3}, "b": true}));
+        assert_eq!(base, serde_json::json!({"a": 1, "n": {"x": 1, "y": 3}, "b": true}));
+    }
+
+    #[test]
+    fn config_hash_ignores_key_order_but_not_values() {
+        let a: serde_json::Value = serde_json::from_str(r#"{"x": 1, "y": 2}"#).unwrap();
+        let b: serde_json::Value = serde_json::from_str(r#"{"y": 2, "x": 1}"#).unwrap();
+        let c: serde_json::Value = serde_json::from_str(r#"{"y": 2, "x": 2}"#).unwrap();
+        assert_eq!(config_hash(&a), config_hash(&b));
+        assert_ne!(config_hash(&a), config_hash(&c));
+    }
+}

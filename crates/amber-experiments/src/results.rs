@@ -1,0 +1,190 @@
+//! The results schema every experiment writes (`results.json`): per-problem evaluations are
+//! reduced to one [`RunResult`] per (method, variant, difficulty, seed).
+
+use amber_train::{MeshMetrics, Rollout, StepStatus};
+use serde::{Deserialize, Serialize};
+
+/// One test problem's rollout, as cached beside a trained run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ProblemEvaluation {
+    /// M⁰ against the expert.
+    pub initial: MeshMetrics,
+    /// Status and metrics after each generation step (failed steps carry the last mesh).
+    pub steps: Vec<StepEvaluation>,
+    /// d(M⁰, M*).
+    pub initial_dcd: f64,
+    /// d(M̂, M*).
+    pub reconstruction_dcd: f64,
+    /// Elements of the expert mesh.
+    pub expert_elements: usize,
+}
+
+/// One generation step of a rollout.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepEvaluation {
+    pub status: StepStatus,
+    pub metrics: MeshMetrics,
+}
+
+impl ProblemEvaluation {
+    /// The record of `rollout` of a problem whose expert has `expert_elements` elements.
+    pub fn of<const D: usize>(rollout: &Rollout<D>, expert_elements: usize) -> Self {
+        Self {
+            initial: rollout.initial,
+            steps: rollout
+                .steps
+                .iter()
+                .map(|s| StepEvaluation { status: s.status.clone(), metrics: s.metrics })
+                .collect(),
+            initial_dcd: rollout.initial_dcd,
+            reconstruction_dcd: rollout.reconstruction_dcd,
+            expert_elements,
+        }
+    }
+
+    /// The metrics after the last step.
+    pub fn last(&self) -> &MeshMetrics {
+        self.steps.last().map_or(&self.initial, |s| &s.metrics)
+    }
+}
+
+/// One trained and evaluated configuration: the means over the test problems.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    pub method: String,
+    pub variant: String,
+    pub difficulty: String,
+    pub seed: usize,
+    /// Test problems evaluated.
+    pub test_problems: usize,
+    /// Mean normalised DCD after the last generation step.
+    pub ndcd: f64,
+    /// 25 % and 75 % quantiles of the per-problem final normalised DCD.
+    pub ndcd_quantiles: [f64; 2],
+    /// Mean normalised DCD after each generation step.
+    pub ndcd_per_step: Vec<f64>,
+    /// Mean raw d(Mᵀ, M*).
+    pub dcd: f64,
+    /// Mean raw d(M⁰, M*).
+    pub dcd_initial: f64,
+    /// Mean raw d(M̂, M*).
+    pub dcd_reconstruction: f64,
+    /// Mean volume difference of Mᵀ and M*.
+    pub volume_difference: f64,
+    /// Mean elements of Mᵀ.
+    pub elements: f64,
+    /// Mean elements of M*.
+    pub expert_elements: f64,
+    /// Generation steps that were over budget or failed, over all problems.
+    pub failed_steps: usize,
+    pub train_seconds: f64,
+    pub eval_seconds: f64,
+}
+
+/// Where a run result came from, apart from its evaluations.
+pub struct RunKey<'a> {
+    pub method: &'a str,
+    pub variant: &'a str,
+    pub difficulty: &'a str,
+    pub seed: usize,
+    pub train_seconds: f64,
+    pub eval_seconds: f64,
+}
+
+impl RunResult {
+    /// Reduces per-problem evaluations (at least one) to the run's row.
+    pub fn new(key: RunKey<'_>, problems: &[ProblemEvaluation]) -> Self {
+        let n = problems.len().max(1) as f64;
+        let mean = |f: &dyn Fn(&ProblemEvaluation) -> f64| problems.iter().map(f).sum::<f64>() / n;
+        let mut finals: Vec<f64> = problems.iter().map(|p| p.last().normalised_dcd).collect();
+        finals.sort_by(f64::total_cmp);
+        let steps = problems.iter().map(|p| p.steps.len()).min().unwrap_or(0);
+        Self {
+            method: key.method.into(),
+            variant: key.variant.into(),
+            difficulty: key.difficulty.into(),
+            seed: key.seed,
+            test_problems: problems.len(),
+            ndcd: mean(&|p| p.last().normalised_dcd),
+            ndcd_quantiles: [quantile(&finals, 0.25), quantile(&finals, 0.75)],
+            ndcd_per_step: (0..steps).map(|t| mean(&|p| p.steps[t].metrics.normalised_dcd)).collect(),
+            dcd: mean(&|p| p.last().dcd),
+            dcd_initial: mean(&|p| p.initial_dcd),
+            dcd_reconstruction: mean(&|p| p.reconstruction_dcd),
+            volume_difference: mean(&|p| p.last().volume_difference),
+            elements: mean(&|p| p.last().elements as f64),
+            expert_elements: mean(&|p| p.expert_elements as f64),
+            failed_steps: problems
+                .iter()
+                .flat_map(|p| &p.steps)
+                .filter(|s| !matches!(s.status, StepStatus::Meshed))
+                .count(),
+            train_seconds: key.train_seconds,
+            eval_seconds: key.eval_seconds,
+        }
+    }
+}
+
+/// Linear-interpolation quantile of sorted values (NaN for none).
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    match sorted.len() {
+        0 => f64::NAN,
+        n => {
+            let x = q * (n - 1) as f64;
+            let (i, frac) = (x.floor() as usize, x.fract());
+            sorted[i] + frac * (sorted[(i + 1).min(n - 1)] - sorted[i])
+        }
+    }
+}
+
+/// `results.json`: one experiment.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExperimentResults {
+    /// `poisson`, `console` or `ablate`.
+    pub experiment: String,
+    pub profile: String,
+    /// The commit the code was built from (`-dirty` with local changes).
+    pub commit: Option<String>,
+    /// CPU, cores, memory, load.
+    pub machine: serde_json::Value,
+    /// Everything needed to rerun: the experiment's settings and each run's training config.
+    pub config: serde_json::Value,
+    pub runs: Vec<RunResult>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn metrics(ndcd: f64) -> MeshMetrics {
+        MeshMetrics { dcd: ndcd, normalised_dcd: ndcd, chamfer: 0.0, volume_difference: 0.0, elements: 10 }
+    }
+
+    fn evaluation(per_step: &[f64], failed_last: bool) -> ProblemEvaluation {
+        let steps = per_step
+            .iter()
+            .enumerate()
+            .map(|(t, &v)| StepEvaluation {
+                status: if failed_last && t + 1 == per_step.len() {
+                    StepStatus::OverBudget { estimated_elements: 1e6 }
+                } else {
+                    StepStatus::Meshed
+                },
+                metrics: metrics(v),
+            })
+            .collect();
+        ProblemEvaluation { initial: metrics(1.0), steps, initial_dcd: 0.5, reconstruction_dcd: 0.2, expert_elements: 20 }
+    }
+
+    #[test]
+    fn runs_reduce_to_means_quantiles_and_failure_counts() {
+        let problems = [evaluation(&[0.8, 0.4], false), evaluation(&[0.6, 0.2], true), evaluation(&[0.7, 0.3], false)];
+        let key = RunKey { method: "m", variant: "v", difficulty: "hard", seed: 0, train_seconds: 1.0, eval_seconds: 2.0 };
+        let run = RunResult::new(key, &problems);
+        assert!((run.ndcd - 0.3).abs() < 1e-12);
+        assert!((run.ndcd_per_step[0] - 0.7).abs() < 1e-12 && (run.ndcd_per_step[1] - 0.3).abs() < 1e-12);
+        assert!((run.ndcd_quantiles[0] - 0.25).abs() < 1e-12 && (run.ndcd_quantiles[1] - 0.35).abs() < 1e-12);
+        assert_eq!(run.failed_steps, 1);
+        assert_eq!((run.test_problems, run.expert_elements), (3, 20.0));
+    }
+}

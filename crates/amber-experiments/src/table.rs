@@ -1,0 +1,130 @@
+//! `table.md`: the paper's layout (normalised DCD, mean and 25–75 % quantiles per method and
+//! difficulty) with the paper's number beside ours, and a second table of the raw numbers.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+use crate::results::{ExperimentResults, RunResult};
+
+/// The paper's normalised DCD of a row (method label) and column (difficulty or setting), where
+/// the paper gives one.
+pub type PaperNumber = dyn Fn(&str, &str) -> Option<f64>;
+
+/// The runs of one (row, column) cell: all seeds.
+fn cells(results: &ExperimentResults) -> (Vec<String>, Vec<String>, BTreeMap<(String, String), Vec<&RunResult>>) {
+    let mut rows: Vec<String> = Vec::new();
+    let mut columns: Vec<String> = Vec::new();
+    let mut cells: BTreeMap<(String, String), Vec<&RunResult>> = BTreeMap::new();
+    for run in &results.runs {
+        let row = row_label(run);
+        if !rows.contains(&row) {
+            rows.push(row.clone());
+        }
+        if !columns.contains(&run.difficulty) {
+            columns.push(run.difficulty.clone());
+        }
+        cells.entry((row, run.difficulty.clone())).or_default().push(run);
+    }
+    (rows, columns, cells)
+}
+
+/// The row label of a run: its method, plus its variant unless it is the default.
+pub fn row_label(run: &RunResult) -> String {
+    match run.variant.as_str() {
+        "default" => run.method.clone(),
+        variant => format!("{} ({variant})", run.method),
+    }
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    sum / n.max(1) as f64
+}
+
+/// The Markdown of both tables.
+pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
+    let (rows, columns, cells) = cells(results);
+    let mut md = String::new();
+    let seeds = results.runs.iter().map(|r| r.seed).max().map_or(0, |s| s + 1);
+    let _ = writeln!(
+        md,
+        "# {} — profile `{}`\n\nNormalised DCD after the last generation step on the test problems (lower is better; \
+         0 = as good as re-meshing with the expert's own sizing field, 1 = no better than M⁰): mean over problems \
+         [25 %, 75 % quantiles], averaged over {seeds} seed(s). *Paper* is the paper's number (mean of 4 seeds) where \
+         it gives one.\n",
+        results.experiment, results.profile
+    );
+    let _ = write!(md, "| method |");
+    for c in &columns {
+        let _ = write!(md, " {c} | paper |");
+    }
+    let _ = write!(md, "\n|---|");
+    for _ in &columns {
+        let _ = write!(md, "---|---|");
+    }
+    md.push('\n');
+    for row in &rows {
+        let _ = write!(md, "| {row} |");
+        for c in &columns {
+            match cells.get(&(row.clone(), c.clone())) {
+                Some(runs) => {
+                    let _ = write!(
+                        md,
+                        " {:.3} [{:.3}, {:.3}] |",
+                        mean(runs.iter().map(|r| r.ndcd)),
+                        mean(runs.iter().map(|r| r.ndcd_quantiles[0])),
+                        mean(runs.iter().map(|r| r.ndcd_quantiles[1]))
+                    );
+                }
+                None => md.push_str(" – |"),
+            }
+            match paper(row, c) {
+                Some(p) => {
+                    let _ = write!(md, " {p:.3} |");
+                }
+                None => md.push_str(" – |"),
+            }
+        }
+        md.push('\n');
+    }
+    let _ = writeln!(
+        md,
+        "\n## Raw numbers\n\nMeans over test problems and seeds: raw DCD of the final mesh d(Mᵀ), of M⁰ and of the \
+         reconstruction M̂ to the expert; normalised DCD per generation step; elements (expert); failed or \
+         over-budget generation steps (summed); training and evaluation wall time.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| method | setting | d(Mᵀ) | d(M⁰) | d(M̂) | nDCD per step | elements (expert) | volume diff. | failed steps | \
+         train s | eval s |\n|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for row in &rows {
+        for c in &columns {
+            let Some(runs) = cells.get(&(row.clone(), c.clone())) else { continue };
+            let steps = runs.iter().map(|r| r.ndcd_per_step.len()).min().unwrap_or(0);
+            let per_step: Vec<String> =
+                (0..steps).map(|t| format!("{:.3}", mean(runs.iter().map(|r| r.ndcd_per_step[t])))).collect();
+            let _ = writeln!(
+                md,
+                "| {row} | {c} | {:.4} | {:.4} | {:.4} | {} | {:.0} ({:.0}) | {:.3e} | {} | {:.0} | {:.0} |",
+                mean(runs.iter().map(|r| r.dcd)),
+                mean(runs.iter().map(|r| r.dcd_initial)),
+                mean(runs.iter().map(|r| r.dcd_reconstruction)),
+                per_step.join(", "),
+                mean(runs.iter().map(|r| r.elements)),
+                mean(runs.iter().map(|r| r.expert_elements)),
+                mean(runs.iter().map(|r| r.volume_difference)),
+                runs.iter().map(|r| r.failed_steps).sum::<usize>(),
+                mean(runs.iter().map(|r| r.train_seconds)),
+                mean(runs.iter().map(|r| r.eval_seconds)),
+            );
+        }
+    }
+    let _ = writeln!(
+        md,
+        "\nCommit `{}`; machine: {}.",
+        results.commit.as_deref().unwrap_or("unknown"),
+        results.machine
+    );
+    md
+}

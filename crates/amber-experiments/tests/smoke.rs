@@ -1,0 +1,112 @@
+//! The smoke profile of `reproduce poisson` end to end (what CI runs): datasets, training of
+//! AMBER-Mean and AMBER-Max, test rollouts, and every output; then a rerun that must reuse the
+//! cached runs and reproduce the same results.
+
+use std::path::Path;
+
+use amber_experiments::{ExperimentResults, PoissonExperiment};
+use amber_train::Profile;
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().unwrap();
+    (reader.info().width, reader.info().height)
+}
+
+#[test]
+fn smoke_profile_writes_every_output_and_reuses_its_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut experiment = PoissonExperiment::new(Profile::Smoke);
+    experiment.manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/poisson.json");
+    experiment.data_root = dir.path().join("data/poisson");
+    experiment.runs_root = dir.path().join("data/runs");
+    experiment.out = dir.path().join("results/poisson");
+    let results = experiment.run().unwrap();
+
+    // results.json is the schema the issue names, and what run() returned.
+    let text = std::fs::read_to_string(experiment.out.join("results.json")).unwrap();
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for key in ["experiment", "profile", "commit", "machine", "config", "runs"] {
+        assert!(value.get(key).is_some(), "results.json lacks `{key}`");
+    }
+    assert_eq!(serde_json::from_value::<ExperimentResults>(value.clone()).unwrap(), results);
+    let runs = value["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2, "AMBER-Mean and AMBER-Max on easy, one seed");
+    let fields = [
+        "method", "variant", "difficulty", "seed", "ndcd", "ndcd_quantiles", "ndcd_per_step", "dcd", "dcd_initial",
+        "dcd_reconstruction", "volume_difference", "elements", "expert_elements", "failed_steps", "train_seconds",
+        "eval_seconds",
+    ];
+    let steps = amber_train::TrainingConfig::smoke().inference_steps;
+    for run in runs {
+        for key in fields {
+            assert!(run.get(key).is_some(), "a run lacks `{key}`: {run}");
+        }
+        assert_eq!(run["ndcd_per_step"].as_array().unwrap().len(), steps);
+        assert_eq!(run["test_problems"], 3);
+        let ndcd = run["ndcd"].as_f64().unwrap();
+        assert!(ndcd.is_finite(), "{run}");
+        let q = run["ndcd_quantiles"].as_array().unwrap();
+        assert!(q[0].as_f64().unwrap() <= q[1].as_f64().unwrap());
+        // d(M̂) < d(M⁰): the normalisation is well defined.
+        assert!(run["dcd_reconstruction"].as_f64().unwrap() < run["dcd_initial"].as_f64().unwrap(), "{run}");
+        assert!(run["train_seconds"].as_f64().unwrap() > 0.0);
+    }
+    let methods: Vec<&str> = runs.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(methods, ["amber-mean", "amber-max"]);
+
+    // The table names every method with its numbers; the pictures are real PNGs.
+    let table = std::fs::read_to_string(experiment.out.join("table.md")).unwrap();
+    for run in &results.runs {
+        assert!(table.contains(&format!("| {} | {:.3}", run.method, run.ndcd)), "{table}");
+    }
+    assert_eq!(png_size(&experiment.out.join("ndcd_bars.png")), (1000, 620));
+    assert_eq!(png_size(&experiment.out.join("ndcd_per_step_easy.png")), (1000, 620));
+    // Two methods × two problems, steps 1, 2, T and the expert.
+    assert_eq!(png_size(&experiment.out.join("gallery_easy.png")), (4 * 420, 4 * 380));
+
+    // A rerun trains and evaluates nothing: the same numbers come back from the caches.
+    let again = experiment.run().unwrap();
+    assert_eq!(again.runs, results.runs);
+}
+
+#[test]
+fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut experiment = PoissonExperiment::ablation(Profile::Smoke);
+    experiment.manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/poisson.json");
+    experiment.data_root = dir.path().join("data/poisson");
+    experiment.runs_root = dir.path().join("data/runs");
+    experiment.out = dir.path().join("results/ablate");
+    // Few steps: this checks the plumbing of every variant, not their quality.
+    experiment.overrides = serde_json::json!({ "steps": 24, "checkpoint_interval": 12, "validation_interval": 0 });
+    let results = experiment.run().unwrap();
+    assert_eq!(results.experiment, "ablate");
+    let rows: Vec<String> = results.runs.iter().map(amber_experiments::row_label).collect();
+    assert_eq!(
+        rows,
+        [
+            "amber-mean",
+            "amber-max",
+            "amber-mean (log-loss)",
+            "amber-max (log-loss)",
+            "amber-max (no-softplus)",
+            "amber-max (random-buffer)",
+            "amber-max (no-input-normalisation)",
+            "amber-max (1-problems)",
+            "amber-max (3-problems)",
+        ]
+    );
+    // Each variant really changed its run's config.
+    let configs = results.config["runs"].as_array().unwrap();
+    let training = |k: usize| &configs[k]["training"];
+    assert_eq!(training(2)["objective"], "log");
+    assert_eq!(training(4)["objective"], "linear");
+    assert_eq!(training(5)["source_selection"], "uniform");
+    assert_eq!(training(6)["normalise_inputs"], false);
+    assert_eq!(training(8)["data"]["train_problems"], 3);
+    assert!(results.runs.iter().all(|r| r.ndcd.is_finite() && r.ndcd_per_step.len() == 3));
+    let table = std::fs::read_to_string(experiment.out.join("table.md")).unwrap();
+    assert!(table.contains("| amber-max (no-softplus) |"), "{table}");
+    assert!(experiment.out.join("ndcd_bars.png").exists());
+}

@@ -1,0 +1,450 @@
+//! The end-to-end 3D generator (spec §2, 3D): a closed CAD-face-labelled reference surface and
+//! a sizing field in, a tetrahedral mesh whose element sizes follow the field out.
+//!
+//! Two stages, because TetGen never coarsens its input surface: [`remesh`](super::remesh())
+//! adapts the reference surface to the field — capped by curvature, h ≤ √(8·r·ε), so that
+//! curved CAD faces stay within ε of the straight edges — and TetGen fills the remeshed surface
+//! with `-pYq1.4/20mO7/7o/150`, taking the sizes of new points from a convex background mesh
+//! (the Delaunay tetrahedralisation of the surface vertices and padded bounding-box corners)
+//! with the field's values at its nodes. An element cap bounds both stages: a field asking for
+//! too many elements is a typed error, never a runaway.
+
+use rstar::RTree;
+use rstar::primitives::GeomWithData;
+
+use super::remesh::{RemeshError, RemeshParams, remesh};
+use super::surface::{Surface, SurfaceDefect};
+use super::tetgen::{TetgenError, TetgenSwitches, delaunay, tetrahedralize};
+use crate::SizingField;
+use amber_mesh::Mesh3;
+
+/// Settings of [`generate_3d`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mesh3dParams {
+    /// The surface remesher's settings (its triangle cap is lowered to what `max_elements` allows).
+    pub remesh: RemeshParams,
+    /// ε in the curvature cap h ≤ √(8·r·ε): the largest distance (in the units of the surface,
+    /// mm for Console) between an edge on a curved face and the face.
+    pub curvature_tolerance: f64,
+    /// The field is multiplied by this before meshing: TetGen's tets are less regular than the
+    /// regular tet that defines h(K) (spec §0), so a field followed edge by edge gives elements
+    /// a little smaller than asked; fitted on the Console training parts (oracle re-mesh).
+    pub size_factor: f64,
+    /// TetGen's switches for the volume.
+    pub switches: TetgenSwitches,
+    /// Stop with [`Mesh3dError::TooManyElements`] rather than build more tets than this.
+    pub max_elements: usize,
+}
+
+impl Default for Mesh3dParams {
+    fn default() -> Self {
+        // Fitted on the Console parts with the expert's own field (`cargo xtask bench mesher3d`):
+        // ε = 0.05 mm keeps the enclosed volume within 0.1 % and the bends no finer than the
+        // expert's; four remeshing rounds give the same meshes as six, faster.
+        Self {
+            remesh: RemeshParams { iterations: 4, ..RemeshParams::default() },
+            curvature_tolerance: 0.05,
+            size_factor: 1.12,
+            switches: TetgenSwitches::default(),
+            max_elements: 1_000_000,
+        }
+    }
+}
+
+impl Mesh3dParams {
+    /// The same settings with another element cap.
+    pub fn with_max_elements(self, max_elements: usize) -> Self {
+        Self { max_elements, ..self }
+    }
+}
+
+/// Why [`generate_3d`] failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Mesh3dError {
+    /// The reference surface does not bound a solid.
+    #[error("the reference surface is invalid: {0}")]
+    InvalidSurface(#[source] SurfaceDefect),
+    /// The sizing field returned a size that is not positive and finite.
+    #[error("the sizing field returned {value} at {at:?}; sizes must be positive and finite")]
+    InvalidSize { at: [f64; 3], value: f64 },
+    /// The field asks for more elements than the cap (`estimated` is the surface-based
+    /// estimate, or the count TetGen reached).
+    #[error("the mesh would exceed the cap of {cap} elements (about {estimated} needed; sizes too small?)")]
+    TooManyElements { cap: usize, estimated: usize },
+    /// The surface remesher failed.
+    #[error("surface remeshing failed: {0}")]
+    Remesh(#[source] RemeshError),
+    /// TetGen failed on the remeshed surface.
+    #[error("TetGen failed on the remeshed surface: {0}")]
+    Tetgen(#[from] TetgenError),
+}
+
+impl From<RemeshError> for Mesh3dError {
+    fn from(e: RemeshError) -> Self {
+        match e {
+            RemeshError::InvalidSize { at, value } => Self::InvalidSize { at, value },
+            other => Self::Remesh(other),
+        }
+    }
+}
+
+impl From<Mesh3dError> for crate::MeshgenError {
+    /// The generator-independent view of a 3D failure (the training loop reacts to
+    /// `TooManyElements` and reports the rest).
+    fn from(e: Mesh3dError) -> Self {
+        match e {
+            Mesh3dError::TooManyElements { cap, .. } => Self::TooManyElements { cap },
+            Mesh3dError::InvalidSize { at, value } => Self::InvalidSize { at: at.to_vec(), value },
+            Mesh3dError::InvalidSurface(defect) => Self::InvalidDomain(defect.to_string()),
+            other => Self::Triangulation(other.to_string()),
+        }
+    }
+}
+
+/// Meshes the solid bounded by `reference` with tets whose sizes follow `field` (target edge
+/// lengths, spec §0): [`adapt_surface`], then [`fill_surface`]. Deterministic (no randomness).
+pub fn generate_3d(
+    reference: &Surface,
+    field: &impl SizingField<3>,
+    params: &Mesh3dParams,
+) -> Result<Mesh3, Mesh3dError> {
+    fill_surface(&adapt_surface(reference, field, params)?, field, params)
+}
+
+/// The first stage of [`generate_3d`]: validates `reference` unless it has been (closed,
+/// manifold, oriented, no self-intersections) and remeshes it to `field` capped by curvature (h ≤ √(8·r·ε)),
+/// refusing fields that would need more triangles than the element cap allows.
+pub fn adapt_surface(
+    reference: &Surface,
+    field: &impl SizingField<3>,
+    params: &Mesh3dParams,
+) -> Result<Surface, Mesh3dError> {
+    let validated;
+    let reference = if reference.is_validated() {
+        reference
+    } else {
+        let mut copy = reference.clone();
+        copy.validate().map_err(Mesh3dError::InvalidSurface)?;
+        validated = copy;
+        &validated
+    };
+    let field = CurvatureCappedField::new(reference, field, params.size_factor, params.curvature_tolerance);
+    // A closed surface of T triangles bounds at least T/4 tets: more triangles than 4·cap
+    // cannot make an acceptable mesh.
+    let max_triangles = params.remesh.max_triangles.min(params.max_elements.saturating_mul(4));
+    let estimated = estimated_triangles(reference, &field)?;
+    if estimated > max_triangles as f64 {
+        return Err(Mesh3dError::TooManyElements { cap: params.max_elements, estimated: (estimated / 4.0) as usize });
+    }
+    let remesh_params = RemeshParams { max_triangles, ..params.remesh };
+    remesh(reference, &field, &remesh_params).map_err(|e| match e {
+        RemeshError::TooManyTriangles { cap } => {
+            Mesh3dError::TooManyElements { cap: params.max_elements, estimated: cap / 4 }
+        }
+        other => other.into(),
+    })
+}
+
+/// The second stage of [`generate_3d`]: fills a valid closed `surface` with tets (TetGen, the
+/// surface kept as it is), sized by `field` at the surface vertices and, for new points, by
+/// linear interpolation in a convex background mesh of the surface vertices. The result is
+/// positively oriented; more than `params.max_elements` tets is an error.
+pub fn fill_surface(
+    surface: &Surface,
+    field: &impl SizingField<3>,
+    params: &Mesh3dParams,
+) -> Result<Mesh3, Mesh3dError> {
+    let sizes = surface
+        .vertices()
+        .iter()
+        .map(|&p| checked_size(field, p).map(|h| params.size_factor * h))
+        .collect::<Result<Vec<_>, _>>()?;
+    let (background, background_sizes) = background_mesh(surface, &sizes)?;
+    // TetGen's Steiner-point cap: a mesh with `max_elements` tets has far fewer points, so
+    // reaching it means the cap is exceeded.
+    let switches = TetgenSwitches { max_steiner_points: Some(params.max_elements), ..params.switches };
+    let out = tetrahedralize(&surface.to_plc(), Some(&sizes), Some((&background, &background_sizes)), &switches)?;
+    let tets = out.mesh.num_elements();
+    if tets > params.max_elements {
+        return Err(Mesh3dError::TooManyElements { cap: params.max_elements, estimated: tets });
+    }
+    Ok(out.mesh)
+}
+
+fn checked_size(field: &impl SizingField<3>, p: [f64; 3]) -> Result<f64, Mesh3dError> {
+    let h = field.size_at(p);
+    if h.is_finite() && h > 0.0 { Ok(h) } else { Err(Mesh3dError::InvalidSize { at: p, value: h }) }
+}
+
+/// The remeshed surface's triangle count if every reference triangle were covered by
+/// triangles of the size at its centroid.
+fn estimated_triangles(reference: &Surface, field: &impl SizingField<3>) -> Result<f64, Mesh3dError> {
+    let v = reference.vertices();
+    let mut total = 0.0;
+    for t in reference.triangles() {
+        let [a, b, c] = t.map(|i| v[i as usize]);
+        let h = checked_size(field, centroid(a, b, c))?;
+        total += 0.5 * norm(cross(sub(b, a), sub(c, a))) / (3f64.sqrt() / 4.0 * h * h);
+    }
+    Ok(total)
+}
+
+/// The convex background mesh for TetGen's `-m`: the Delaunay tetrahedralisation of the
+/// surface vertices and the corners of their bounding box grown by a tenth of its diagonal,
+/// with the surface sizes at the vertices and the nearest vertex's size at each corner.
+fn background_mesh(surface: &Surface, sizes: &[f64]) -> Result<(Mesh3, Vec<f64>), Mesh3dError> {
+    let points = surface.vertices();
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let padding = 0.1 * norm(sub(hi, lo));
+    let tree = RTree::bulk_load(points.iter().enumerate().map(|(i, &p)| GeomWithData::new(p, i)).collect());
+    let mut all = points.to_vec();
+    let mut all_sizes = sizes.to_vec();
+    for c in 0..8 {
+        let corner = [0, 1, 2].map(|k| if c >> k & 1 == 0 { lo[k] - padding } else { hi[k] + padding });
+        let nearest = tree.nearest_neighbor(corner).map_or(0, |n| n.data);
+        all.push(corner);
+        all_sizes.push(sizes[nearest]);
+    }
+    Ok((delaunay(&all)?, all_sizes))
+}
+
+/// A field scaled by a factor and capped by the curvature of the reference surface: at a point whose nearest
+/// reference triangle lies on a face of radius r, h ≤ √(8·r·ε) (the sagitta of a chord of
+/// length h on a circle of radius r is h²/(8r)).
+struct CurvatureCappedField<'f, F> {
+    inner: &'f F,
+    factor: f64,
+    /// Reference triangle centroids with the cap there (∞ on flat regions).
+    caps: RTree<GeomWithData<[f64; 3], f64>>,
+}
+
+impl<'f, F: SizingField<3>> CurvatureCappedField<'f, F> {
+    fn new(reference: &Surface, inner: &'f F, factor: f64, tolerance: f64) -> Self {
+        let curvature = triangle_curvatures(reference);
+        let v = reference.vertices();
+        let caps = reference
+            .triangles()
+            .iter()
+            .zip(curvature)
+            .map(|(t, kappa)| {
+                let [a, b, c] = t.map(|i| v[i as usize]);
+                let cap = if kappa > 0.0 { (8.0 * tolerance / kappa).sqrt() } else { f64::INFINITY };
+                GeomWithData::new(centroid(a, b, c), cap)
+            })
+            .collect();
+        Self { inner, factor, caps: RTree::bulk_load(caps) }
+    }
+}
+
+impl<F: SizingField<3>> SizingField<3> for CurvatureCappedField<'_, F> {
+    fn size_at(&self, x: [f64; 3]) -> f64 {
+        let h = self.factor * self.inner.size_at(x);
+        // NaN stays NaN: `min` would hide it behind the cap.
+        match self.caps.nearest_neighbor(x) {
+            Some(n) if !h.is_nan() => h.min(n.data),
+            _ => h,
+        }
+    }
+}
+
+/// Curvature 1/r of the reference surface at every triangle: across each edge shared with a
+/// triangle of the same CAD face, the turn of the normal divided by the distance between the
+/// centroids (exact for a polygonised circle); the largest over the triangle's edges. Edges
+/// between CAD faces are creases, not curvature.
+fn triangle_curvatures(reference: &Surface) -> Vec<f64> {
+    let (v, triangles, faces) = (reference.vertices(), reference.triangles(), reference.face_ids());
+    let corners = |t: usize| triangles[t].map(|i| v[i as usize]);
+    let unit_normal = |t: usize| {
+        let [a, b, c] = corners(t);
+        let n = cross(sub(b, a), sub(c, a));
+        let l = norm(n);
+        n.map(|x| x / l)
+    };
+    let mut edges: Vec<([u32; 2], usize)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(t, tri)| (0..3).map(move |k| ([tri[k].min(tri[(k + 1) % 3]), tri[k].max(tri[(k + 1) % 3])], t)))
+        .collect();
+    edges.sort_unstable();
+    let mut curvature = vec![0.0f64; triangles.len()];
+    for pair in edges.windows(2) {
+        let ((e, s), (f, t)) = (pair[0], pair[1]);
+        if e != f || faces[s] != faces[t] {
+            continue;
+        }
+        let (cs, ct) = (corners(s), corners(t));
+        let distance = norm(sub(centroid(cs[0], cs[1], cs[2]), centroid(ct[0], ct[1], ct[2])));
+        let turn = norm(sub(unit_normal(s), unit_normal(t)));
+        if distance > 0.0 && turn.is_finite() {
+            let kappa = turn / distance;
+            curvature[s] = curvature[s].max(kappa);
+            curvature[t] = curvature[t].max(kappa);
+        }
+    }
+    curvature
+}
+
+fn centroid(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh3d::console_reference_surfaces;
+    use crate::mesh3d::surface::StlFaceIds;
+    use crate::{ConstantSize, FnSize, MeshSizing};
+    use proptest::prelude::*;
+    use proptest::test_runner::RngSeed;
+    use std::path::{Path, PathBuf};
+
+    /// The unit cube as 12 triangles, one CAD face per side (corners (i&1, i>>1&1, i>>2&1)).
+    fn cube_triangles() -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<i32>) {
+        let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let mut triangles = Vec::new();
+        let mut ids = Vec::new();
+        for (side, q) in quads.iter().enumerate() {
+            triangles.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
+            ids.extend([side as i32 + 1; 2]);
+        }
+        (v, triangles, ids)
+    }
+
+    fn cube() -> Surface {
+        let (v, t, ids) = cube_triangles();
+        Surface::new(v, t, ids).unwrap()
+    }
+
+    #[test]
+    fn cube_is_meshed_to_a_graded_field() {
+        let h = |p: [f64; 3]| 0.08 + 0.15 * p[0];
+        let mesh = generate_3d(&cube(), &FnSize(h), &Mesh3dParams::default()).unwrap();
+        assert!((mesh.total_volume() - 1.0).abs() < 1e-12, "volume {}", mesh.total_volume());
+        let min_dihedral = mesh.min_angles().into_iter().fold(f64::INFINITY, f64::min);
+        assert!(min_dihedral > 5.0, "min dihedral {min_dihedral}");
+        let mut ratios: Vec<f64> = (0..mesh.num_elements()).map(|e| mesh.size(e) / h(mesh.midpoint(e))).collect();
+        ratios.sort_by(f64::total_cmp);
+        let median = ratios[ratios.len() / 2];
+        assert!((0.85..1.25).contains(&median), "median size ratio {median}");
+    }
+
+    #[test]
+    fn a_surface_with_a_hole_is_a_typed_error() {
+        let (v, mut t, mut ids) = cube_triangles();
+        t.pop();
+        ids.pop();
+        let open = Surface::new(v, t, ids).unwrap();
+        let err = generate_3d(&open, &ConstantSize(0.2), &Mesh3dParams::default()).unwrap_err();
+        assert!(matches!(err, Mesh3dError::InvalidSurface(SurfaceDefect::OpenEdges { .. })), "{err}");
+    }
+
+    #[test]
+    fn a_self_intersecting_surface_is_a_typed_error() {
+        let (v, t, ids) = cube_triangles();
+        let shifted: Vec<[f64; 3]> = v.iter().map(|p| [p[0] + 0.5, p[1] + 0.25, p[2] + 0.125]).collect();
+        let n = v.len() as u32;
+        let vertices = [v, shifted].concat();
+        let triangles = [t.clone(), t.iter().map(|tri| tri.map(|i| i + n)).collect()].concat();
+        let faces = [ids.clone(), ids.iter().map(|f| f + 6).collect()].concat();
+        let err = generate_3d(&Surface::new(vertices, triangles, faces).unwrap(), &ConstantSize(0.2), &Mesh3dParams::default())
+            .unwrap_err();
+        assert!(matches!(err, Mesh3dError::InvalidSurface(SurfaceDefect::SelfIntersection { .. })), "{err}");
+    }
+
+    #[test]
+    fn absurd_and_invalid_fields_are_typed_errors() {
+        let err = generate_3d(&cube(), &ConstantSize(1e-9), &Mesh3dParams::default()).unwrap_err();
+        assert!(matches!(err, Mesh3dError::TooManyElements { cap: 1_000_000, .. }), "{err}");
+        let err = generate_3d(&cube(), &ConstantSize(f64::NAN), &Mesh3dParams::default()).unwrap_err();
+        assert!(matches!(err, Mesh3dError::InvalidSize { .. }), "{err}");
+        let err = generate_3d(&cube(), &ConstantSize(-1.0), &Mesh3dParams::default()).unwrap_err();
+        assert!(matches!(err, Mesh3dError::InvalidSize { .. }), "{err}");
+        // The surface fits the cap, the volume does not: TetGen's Steiner-point cap stops it.
+        let params = Mesh3dParams::default().with_max_elements(300);
+        let err = generate_3d(&cube(), &ConstantSize(0.2), &params).unwrap_err();
+        assert!(matches!(err, Mesh3dError::TooManyElements { cap: 300, .. }), "{err}");
+        assert!(matches!(crate::MeshgenError::from(err), crate::MeshgenError::TooManyElements { cap: 300 }));
+    }
+
+    /// The Console data directory next to the reference surfaces, and one small part.
+    fn console_part(name: &str) -> Option<(PathBuf, Surface)> {
+        let files = console_reference_surfaces()?;
+        let stl = files.into_iter().find(|p| p.ends_with(format!("{name}.stl")))?;
+        let data = stl.parent()?.parent()?.parent()?.to_owned();
+        let (surface, _) = Surface::load(&stl, StlFaceIds::FromFile).unwrap();
+        Some((data, surface))
+    }
+
+    /// The oracle re-mesh (the expert's own sizing field) of the smallest Console part meets the
+    /// acceptance bounds of the full benchmark (`cargo xtask bench mesher3d`).
+    #[test]
+    fn console_oracle_remesh_matches_the_expert() {
+        let Some((data, reference)) = console_part("train/002") else { return };
+        let expert: Mesh3 = amber_mesh::read_mesh(data.join("train/002.nas")).unwrap();
+        let field = MeshSizing::from_element_sizes(&expert);
+        let start = std::time::Instant::now();
+        let mesh = generate_3d(&reference, &field, &Mesh3dParams::default()).unwrap();
+        let ratio = mesh.num_elements() as f64 / expert.num_elements() as f64;
+        let mut sizes: Vec<f64> = (0..mesh.num_elements()).map(|e| mesh.size(e) / field.size_at(mesh.midpoint(e))).collect();
+        sizes.sort_by(f64::total_cmp);
+        let median = sizes[sizes.len() / 2];
+        let min_dihedral = mesh.min_angles().into_iter().fold(f64::INFINITY, f64::min);
+        let volume_error = mesh.total_volume() / reference.enclosed_volume() - 1.0;
+        println!(
+            "train/002 oracle: {} tets ({ratio:.2}x expert), size ratio {median:.2}, min dihedral {min_dihedral:.1}°, \
+             volume {volume_error:+.1e}, {:.2} s",
+            mesh.num_elements(),
+            start.elapsed().as_secs_f64()
+        );
+        assert!((0.8..1.3).contains(&ratio) && (0.85..1.15).contains(&median), "{ratio} {median}");
+        assert!(min_dihedral > 5.0 && volume_error.abs() < 5e-3, "{min_dihedral} {volume_error}");
+    }
+
+    /// Closed, 2-manifold, one outward component without self-intersections: `validate` checks
+    /// all of it, and nothing may need re-orienting.
+    fn assert_valid_surface(surface: &Surface, path: &Path) {
+        let mut copy = surface.clone();
+        let report = copy.validate().unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert_eq!((report.components, report.flipped_triangles), (1, 0), "{}", path.display());
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 3, rng_seed: RngSeed::Fixed(8), failure_persistence: None, ..ProptestConfig::default() })]
+
+        /// The remesher on shipped parts with random smooth fields (0.6–6 mm, waves of 10–40 mm).
+        #[test]
+        fn remeshed_console_surfaces_are_valid_for_random_smooth_fields(
+            h0 in 0.8..3.0f64, amplitude in 0.0..0.8f64, wavelength in 10.0..40.0f64, part in 0..2usize,
+        ) {
+            let name = ["train/002", "val/002"][part];
+            let Some((data, reference)) = console_part(name) else { return Ok(()) };
+            let k = std::f64::consts::TAU / wavelength;
+            let field = FnSize(move |x: [f64; 3]| h0 * (1.0 + amplitude * (k * x[0]).sin() * (k * x[1] + 0.5 * k * x[2]).cos()));
+            let surface = adapt_surface(&reference, &field, &Mesh3dParams::default()).unwrap();
+            assert_valid_surface(&surface, &data.join(name));
+            let volume_error = surface.enclosed_volume() / reference.enclosed_volume() - 1.0;
+            prop_assert!(volume_error.abs() < 5e-3, "{name}: volume {volume_error}");
+        }
+    }
+}

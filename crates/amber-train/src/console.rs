@@ -1,0 +1,92 @@
+//! The Console task (spec §9) as a [`Problem<3>`]: geometric features only (node [volume], edge
+//! [3D midpoint difference]), labels from the expert's tet mesh, and every new mesh made by the
+//! 3D generator from the part's reference surface and the piecewise-constant field on the
+//! current mesh.
+
+use amber_graph::FeatureSet;
+use amber_mesh::Mesh;
+use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
+use amber_meshgen::{MeshSizing, MeshgenError};
+use amber_tasks::console::ConsoleProblem;
+
+use crate::task::{Column, Problem, ProblemError};
+
+impl Problem<3> for ConsoleProblem {
+    fn feature_set(&self) -> FeatureSet {
+        FeatureSet::console()
+    }
+
+    fn initial_mesh(&self) -> &Mesh<3> {
+        &self.initial_mesh
+    }
+
+    fn expert_mesh(&self) -> &Mesh<3> {
+        &self.expert_mesh
+    }
+
+    /// None: the Console features are geometric, computed by the graph.
+    fn columns(&self, _mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
+        Ok(Vec::new())
+    }
+
+    fn remesh(&self, mesh: &Mesh<3>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<3>, ProblemError> {
+        let params = Mesh3dParams::default().with_max_elements(max_elements);
+        generate_3d(&self.reference, &MeshSizing::new(mesh, sizes), &params)
+            .map_err(|e| ProblemError::Meshing(MeshgenError::from(e)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::{Path, PathBuf};
+
+    use amber_graph::Aggregation;
+    use amber_tasks::console::ConsoleSplit;
+
+    use super::*;
+    use crate::task::{MeshLimits, MeshState, StepOutcome, generation_step, labels};
+
+    /// The shipped data bundle, or `None` (with a message) when it is absent.
+    fn shipped_data() -> Option<PathBuf> {
+        let candidates =
+            [Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"), "/work/shared/data/console".into()];
+        let found = candidates.into_iter().find(|p| p.join("train").is_dir());
+        if found.is_none() {
+            println!("skipping: the Console data (../shared/data/console) is not present");
+        }
+        found
+    }
+
+    /// One generation step on val/002 from M⁰ with a smoke-size field (3 mm everywhere): a new
+    /// mesh of the same solid with about the expected element count, its graph and labels; and a
+    /// field far too fine is stopped by the budget, not meshed.
+    #[test]
+    fn one_generation_step_on_a_shipped_part() {
+        let Some(data) = shipped_data() else { return };
+        let problem = ConsoleProblem::load(&data, ConsoleSplit::Val, "002").unwrap();
+        let m0 = problem.initial_mesh();
+        let limits = MeshLimits::from_experts([problem.expert_mesh()], 1.2, 0.005);
+        let start = std::time::Instant::now();
+        let StepOutcome::Meshed(mesh) = generation_step(&problem, m0, vec![3.0; m0.num_elements()], &limits) else {
+            panic!("the 3 mm step was not meshed")
+        };
+        let volume = problem.reference.enclosed_volume();
+        let expected = volume / amber_mesh::volume_from_size::<3>(3.0);
+        println!(
+            "{}: M⁰ {} tets -> {} tets with 3 mm (≈{expected:.0} regular tets) in {:.2} s",
+            problem.name,
+            m0.num_elements(),
+            mesh.num_elements(),
+            start.elapsed().as_secs_f64()
+        );
+        assert!((mesh.total_volume() / volume - 1.0).abs() < 5e-3);
+        assert!((0.5 * expected..3.0 * expected).contains(&(mesh.num_elements() as f64)));
+        let state = MeshState::new(&problem, &problem.feature_set(), mesh).unwrap();
+        assert_eq!(state.graph.num_nodes(), state.mesh.num_elements());
+        assert_eq!(state.graph.node_features().len(), state.mesh.num_elements());
+        let y = labels(&problem, &state.mesh, Aggregation::Mean).unwrap();
+        assert!(y.len() == state.mesh.num_elements() && y.iter().all(|h| h.is_finite() && *h > 0.0));
+        let outcome = generation_step(&problem, m0, vec![0.05; m0.num_elements()], &limits);
+        assert!(matches!(outcome, StepOutcome::OverBudget { .. }), "{outcome:?}");
+    }
+}

@@ -1,0 +1,219 @@
+//! `bench cnn`: a training step (forward, masked MSE, backward, clip 0.5, Adam 3e-4) and an
+//! evaluation forward of the U-Net baseline (32 initial channels, depth 4) on a 1×4×256² image
+//! and a 1×1×64³ voxel grid, next to the PyTorch peer (`shared/peers/bench_unet.py`) on the same
+//! shapes in the same session.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use amber_cnn::{CnnLoss, UNet, UNetConfig};
+use amber_mpn::{TrainConfig, Trainer};
+use anyhow::{Context, bail};
+use candle_core::{DType, Device, Tensor};
+use rand::{Rng, SeedableRng};
+use rand::rngs::StdRng;
+use serde_json::{Value, json};
+
+use crate::report;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Where to write the results (JSON).
+    #[arg(long, default_value = "results/bench/cnn.json")]
+    pub out: PathBuf,
+    /// Cases to time: 2d (1×4×256²), 3d (1×1×64³).
+    #[arg(long, value_delimiter = ',', default_value = "2d,3d")]
+    pub cases: Vec<String>,
+    /// Timed iterations per case (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub iters: usize,
+    /// Untimed iterations before timing (first touches of memory are slow).
+    #[arg(long, default_value_t = 1)]
+    pub warmup: usize,
+    /// Initial channels of the U-Net.
+    #[arg(long, default_value_t = 32)]
+    pub channels: usize,
+    /// Python interpreter with torch, to also run the PyTorch peer.
+    #[arg(long)]
+    pub peer_python: Option<PathBuf>,
+    /// The peer script.
+    #[arg(long, default_value = "../shared/peers/bench_unet.py")]
+    pub peer_script: PathBuf,
+    /// Threads for the peer (PEERS_THREADS); ours follow RAYON_NUM_THREADS (default: all cores).
+    #[arg(long, default_value_t = 2)]
+    pub peer_threads: usize,
+}
+
+/// One benchmark shape.
+struct Case {
+    name: &'static str,
+    spatial_axes: usize,
+    in_channels: usize,
+    resolution: usize,
+}
+
+const CASES: [Case; 2] = [
+    Case { name: "2d", spatial_axes: 2, in_channels: 4, resolution: 256 },
+    Case { name: "3d", spatial_axes: 3, in_channels: 1, resolution: 64 },
+];
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    // Never hand freed memory back (15 = mi_option_purge_delay, -1 = no purging): the U-Net's
+    // activations are freed and reallocated every step, and re-faulting their pages cost 13 % of
+    // a step (measured with perf).
+    // SAFETY: sets a process-wide allocator option; mimalloc reads it at each purge.
+    unsafe { libmimalloc_sys::mi_option_set(15, -1) };
+    let mut results = Vec::new();
+    for name in &args.cases {
+        let case = CASES.iter().find(|c| c.name == name).with_context(|| format!("unknown case `{name}` (2d, 3d)"))?;
+        let ours = bench_ours(case, &args)?;
+        println!(
+            "amber-cnn {:>2} {}: train {:7.3} s/step (forward {:.3} s)  infer {:7.3} s  ({} parameters) [load average {}]",
+            case.name,
+            ours["input_shape"],
+            ours["train_s_median"].as_f64().unwrap_or(f64::NAN),
+            ours["train_forward_s_median"].as_f64().unwrap_or(f64::NAN),
+            ours["infer_s_median"].as_f64().unwrap_or(f64::NAN),
+            ours["parameters"],
+            ours["load_average_after"].as_str().unwrap_or("?"),
+        );
+        let peer = match &args.peer_python {
+            Some(python) => Some(run_peer(python, case, &args)?),
+            None => None,
+        };
+        let ratio = |key: &str, peer_key: &str| {
+            let p = peer.as_ref()?[peer_key].as_f64()?;
+            Some(ours[key].as_f64()? / p)
+        };
+        let (train_ratio, infer_ratio) = (ratio("train_s_median", "train_step_s_median"), ratio("infer_s_median", "infer_s_median"));
+        if let (Some(p), Some(t), Some(i)) = (&peer, train_ratio, infer_ratio) {
+            println!(
+                "  torch {:>2}: train {:7.3} s/step  infer {:7.3} s  → ours/torch: train {t:.2}×, infer {i:.2}×",
+                case.name, p["train_step_s_median"].as_f64().unwrap_or(f64::NAN), p["infer_s_median"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+        results.push(json!({
+            "case": case.name,
+            "amber_cnn": ours,
+            "torch": peer,
+            "time_ratio_ours_over_torch": { "train": train_ratio, "infer": infer_ratio },
+        }));
+    }
+    let result = json!({
+        "benchmark": "cnn",
+        "network": { "initial_channels": args.channels, "depth": 4, "bias_in_convs_before_batchnorm": false },
+        "step": "forward (batch statistics) + MSE over all pixels + backward + global-norm clip 0.5 + Adam 3e-4",
+        "rayon_threads": rayon::current_num_threads(),
+        "iters": args.iters,
+        "warmup": args.warmup,
+        "machine": report::machine(),
+        "cases": results,
+    });
+    report::write_json(&args.out, &result)
+}
+
+fn bench_ours(case: &Case, args: &Args) -> anyhow::Result<Value> {
+    let config = UNetConfig {
+        spatial_axes: case.spatial_axes,
+        in_channels: case.in_channels,
+        initial_channels: args.channels,
+        depth: 4,
+    };
+    let net = UNet::init(config, 0, DType::F32)?;
+    let spatial = vec![case.resolution; case.spatial_axes];
+    let input_shape: Vec<usize> = [1, case.in_channels].into_iter().chain(spatial.iter().copied()).collect();
+    let label_shape: Vec<usize> = [1, 1].into_iter().chain(spatial.iter().copied()).collect();
+    let mut rng = StdRng::seed_from_u64(0);
+    let mut random = |shape: &[usize], lo: f32, hi: f32| {
+        let v: Vec<f32> = (0..shape.iter().product()).map(|_| rng.random_range(lo..hi)).collect();
+        Tensor::from_vec(v, shape, &Device::Cpu)
+    };
+    let x = random(&input_shape, -1.0, 1.0)?;
+    let y = random(&label_shape, 0.0, 1.0)?;
+    let mask = Tensor::ones(label_shape.as_slice(), DType::F32, &Device::Cpu)?;
+    let mut trainer = Trainer::new(net.varmap(), &TrainConfig::default())?;
+    let mut forward_s = Vec::new();
+    let mut train_step = || -> anyhow::Result<()> {
+        let started = Instant::now();
+        let loss = CnnLoss::Mse.loss(&net.forward_train(&x)?, &y, &mask)?;
+        forward_s.push(started.elapsed().as_secs_f64());
+        trainer.step(&loss)?;
+        Ok(())
+    };
+    let load_average_before = load_average();
+    let train = time(args, &mut train_step)?;
+    // The timed steps' forward passes (after the warm-up).
+    let forward_s = forward_s.split_off(args.warmup.min(forward_s.len()));
+    let infer = time(args, &mut || -> anyhow::Result<()> {
+        drop(net.forward(&x)?);
+        Ok(())
+    })?;
+    Ok(json!({
+        "input_shape": input_shape,
+        "parameters": net.parameter_count(),
+        "train_s_median": median(&train),
+        "train_s_all": train,
+        "train_forward_s_median": median(&forward_s),
+        "infer_s_median": median(&infer),
+        "infer_s_all": infer,
+        "load_average_before": load_average_before,
+        "load_average_after": load_average(),
+    }))
+}
+
+/// Wall seconds of each timed iteration.
+fn time(args: &Args, step: &mut dyn FnMut() -> anyhow::Result<()>) -> anyhow::Result<Vec<f64>> {
+    for _ in 0..args.warmup {
+        step()?;
+    }
+    (0..args.iters.max(1))
+        .map(|_| {
+            let t = Instant::now();
+            step()?;
+            Ok(t.elapsed().as_secs_f64())
+        })
+        .collect()
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    s[s.len() / 2]
+}
+
+/// `/proc/loadavg`: how busy the shared machine was around a measurement.
+fn load_average() -> Option<String> {
+    std::fs::read_to_string("/proc/loadavg").ok().map(|s| s.trim().to_string())
+}
+
+/// Runs the PyTorch peer with the case's input channels and returns its case of the same
+/// dimension (the script times both dimensions with one channel count).
+fn run_peer(python: &Path, case: &Case, args: &Args) -> anyhow::Result<Value> {
+    let results = std::env::temp_dir().join(format!("amber-peer-unet-{}-{}", case.name, std::process::id()));
+    let status = Command::new(python)
+        .arg(&args.peer_script)
+        .args(["--channels", &case.in_channels.to_string()])
+        .env("PEERS_RESULTS", &results)
+        .env("PEERS_THREADS", args.peer_threads.to_string())
+        .env("PEERS_OMP_WAIT_POLICY", "PASSIVE")
+        .env("PEERS_REPEATS", args.iters.max(1).to_string())
+        .status()
+        .with_context(|| format!("running {} {}", python.display(), args.peer_script.display()))?;
+    if !status.success() {
+        bail!("the peer benchmark failed: {status}");
+    }
+    let path = results.join("unet.json");
+    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    std::fs::remove_dir_all(&results).ok();
+    let mut all: Value = serde_json::from_str(&text)?;
+    let cases = all["cases"].as_array_mut().context("peer result without cases")?;
+    let index = cases
+        .iter()
+        .position(|c| c["dim"] == case.spatial_axes)
+        .with_context(|| format!("the peer has no {}D case", case.spatial_axes))?;
+    let mut chosen = cases.swap_remove(index);
+    chosen["versions"] = all["versions"].take();
+    chosen["torch_num_threads"] = all["torch_num_threads"].take();
+    Ok(chosen)
+}

@@ -1,0 +1,124 @@
+//! `cargo xtask reproduce poisson`: the paper's Poisson experiment end to end (datasets,
+//! training of every method × difficulty × seed, test rollouts, tables and plots under
+//! `results/poisson/`). Trained runs are cached under `data/runs/`, keyed by their config.
+
+use std::path::PathBuf;
+
+use amber_experiments::{Method, MethodSpec, PoissonExperiment, read_json};
+use amber_tasks::poisson::Difficulty;
+use amber_train::Profile;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(subcommand)]
+    experiment: Experiment,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum Experiment {
+    /// Poisson on random L-shapes (spec §1): AMBER-Mean and AMBER-Max per difficulty.
+    Poisson(PoissonArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct PoissonArgs {
+    /// smoke (CI: minutes), quick (default: about an hour on 2 cores), paper (GPU scale).
+    #[arg(long, default_value = "quick")]
+    profile: Profile,
+    /// Difficulties, comma-separated (default: the profile's).
+    #[arg(long, value_delimiter = ',')]
+    difficulty: Vec<Difficulty>,
+    /// Training seeds 0..N (default: the profile's).
+    #[arg(long)]
+    seeds: Option<usize>,
+    /// Methods, comma-separated (default: all).
+    #[arg(long, value_delimiter = ',')]
+    methods: Vec<Method>,
+    /// Evaluate on the problem files (JSON, ours or the reference's format) of this directory
+    /// instead of the generated test split.
+    #[arg(long)]
+    test_set: Option<PathBuf>,
+    /// Evaluate on the first N test problems only.
+    #[arg(long)]
+    test_problems: Option<usize>,
+    /// A JSON file of training-config fields overriding the profile's for every run.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Retrain and re-evaluate even when cached.
+    #[arg(long)]
+    force: bool,
+    /// Output directory.
+    #[arg(long, default_value = "results/poisson")]
+    out: PathBuf,
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    match args.experiment {
+        Experiment::Poisson(args) => poisson(args),
+    }
+}
+
+fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
+    let mut experiment = PoissonExperiment::new(args.profile);
+    if !args.difficulty.is_empty() {
+        experiment.difficulties = args.difficulty;
+    }
+    if let Some(seeds) = args.seeds {
+        experiment.seeds = seeds;
+    }
+    if !args.methods.is_empty() {
+        experiment.methods = args.methods.into_iter().map(MethodSpec::plain).collect();
+    }
+    if let Some(config) = &args.config {
+        experiment.overrides = read_json(config)?;
+    }
+    if args.test_problems.is_some() {
+        experiment.test_problems = args.test_problems;
+    }
+    experiment.test_set = args.test_set;
+    experiment.force = args.force;
+    experiment.out = args.out;
+    let results = experiment.run()?;
+    print_runs(&results);
+    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
+    Ok(())
+}
+
+#[derive(clap::Args, Debug)]
+pub struct AblateArgs {
+    /// smoke (CI: minutes), quick (hours on 2 cores), paper (GPU scale).
+    #[arg(long, default_value = "quick")]
+    profile: Profile,
+    /// Retrain and re-evaluate even when cached.
+    #[arg(long)]
+    force: bool,
+    /// Output directory.
+    #[arg(long, default_value = "results/ablate")]
+    out: PathBuf,
+}
+
+/// `cargo xtask ablate`: every ablation of spec §10 as variants of the same training code.
+pub fn ablate(args: AblateArgs) -> anyhow::Result<()> {
+    let mut experiment = PoissonExperiment::ablation(args.profile);
+    experiment.force = args.force;
+    experiment.out = args.out;
+    let results = experiment.run()?;
+    print_runs(&results);
+    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
+    Ok(())
+}
+
+fn print_runs(results: &amber_experiments::ExperimentResults) {
+    for run in &results.runs {
+        println!(
+            "{} {} seed {}: normalised DCD {:.3} [{:.3}, {:.3}], per step {:?}",
+            amber_experiments::row_label(run),
+            run.difficulty,
+            run.seed,
+            run.ndcd,
+            run.ndcd_quantiles[0],
+            run.ndcd_quantiles[1],
+            run.ndcd_per_step.iter().map(|v| (v * 1000.0).round() / 1000.0).collect::<Vec<_>>()
+        );
+    }
+}
