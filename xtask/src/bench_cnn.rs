@@ -11,8 +11,8 @@ use amber_cnn::{CnnLoss, UNet, UNetConfig};
 use amber_mpn::{TrainConfig, Trainer};
 use anyhow::{Context, bail};
 use candle_core::{DType, Device, Tensor};
-use rand::{Rng, SeedableRng};
 use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
 use serde_json::{Value, json};
 
 use crate::report;
@@ -40,9 +40,9 @@ pub struct Args {
     /// The peer script.
     #[arg(long, default_value = "../shared/peers/bench_unet.py")]
     pub peer_script: PathBuf,
-    /// Threads for the peer (PEERS_THREADS); ours follow RAYON_NUM_THREADS (default: all cores).
+    /// Threads for ours (the rayon pool) and for the peer (PEERS_THREADS).
     #[arg(long, default_value_t = 2)]
-    pub peer_threads: usize,
+    pub threads: usize,
 }
 
 /// One benchmark shape.
@@ -64,6 +64,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // a step (measured with perf).
     // SAFETY: sets a process-wide allocator option; mimalloc reads it at each purge.
     unsafe { libmimalloc_sys::mi_option_set(15, -1) };
+    rayon::ThreadPoolBuilder::new().num_threads(args.threads).build_global().context("starting the thread pool")?;
     let mut results = Vec::new();
     for name in &args.cases {
         let case = CASES.iter().find(|c| c.name == name).with_context(|| format!("unknown case `{name}` (2d, 3d)"))?;
@@ -86,11 +87,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let p = peer.as_ref()?[peer_key].as_f64()?;
             Some(ours[key].as_f64()? / p)
         };
-        let (train_ratio, infer_ratio) = (ratio("train_s_median", "train_step_s_median"), ratio("infer_s_median", "infer_s_median"));
+        let (train_ratio, infer_ratio) =
+            (ratio("train_s_median", "train_step_s_median"), ratio("infer_s_median", "infer_s_median"));
         if let (Some(p), Some(t), Some(i)) = (&peer, train_ratio, infer_ratio) {
             println!(
                 "  torch {:>2}: train {:7.3} s/step  infer {:7.3} s  → ours/torch: train {t:.2}×, infer {i:.2}×",
-                case.name, p["train_step_s_median"].as_f64().unwrap_or(f64::NAN), p["infer_s_median"].as_f64().unwrap_or(f64::NAN)
+                case.name,
+                p["train_step_s_median"].as_f64().unwrap_or(f64::NAN),
+                p["infer_s_median"].as_f64().unwrap_or(f64::NAN)
             );
         }
         results.push(json!({
@@ -195,9 +199,11 @@ fn run_peer(python: &Path, case: &Case, args: &Args) -> anyhow::Result<Value> {
         .arg(&args.peer_script)
         .args(["--channels", &case.in_channels.to_string()])
         .env("PEERS_RESULTS", &results)
-        .env("PEERS_THREADS", args.peer_threads.to_string())
+        .env("PEERS_THREADS", args.threads.to_string())
         .env("PEERS_OMP_WAIT_POLICY", "PASSIVE")
         .env("PEERS_REPEATS", args.iters.max(1).to_string())
+        // The peer waits (bounded) for a quiet machine before timing; a shared machine may never be.
+        .env("PEERS_MAX_WAIT", "10")
         .status()
         .with_context(|| format!("running {} {}", python.display(), args.peer_script.display()))?;
     if !status.success() {

@@ -61,9 +61,9 @@ mod tests {
     #[test]
     fn targets_and_sizes_invert_each_other() {
         for loss in [CnnLoss::LogMse, CnnLoss::SoftplusMse, CnnLoss::Mse] {
-            let y = 0.37;
+            let y: f64 = 0.37;
             let z = match loss {
-                CnnLoss::SoftplusMse => y + (-(-y as f64).exp_m1()).ln(),
+                CnnLoss::SoftplusMse => y + (-(-y).exp_m1()).ln(),
                 _ => loss.target(y),
             };
             assert!((loss.size(z) - y).abs() < 1e-12, "{loss:?}");

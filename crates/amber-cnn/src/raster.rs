@@ -27,7 +27,8 @@ impl<const D: usize> PixelGrid<D> {
     /// the box is not, as in the reference).
     pub fn over_mesh(mesh: &Mesh<D>, resolution: usize) -> Result<Self> {
         let (lo, hi) = mesh.bounding_box().ok_or_else(|| CnnError::EmptyMesh("the mesh has no vertices".into()))?;
-        if resolution == 0 || (0..D).any(|k| !(hi[k] > lo[k])) {
+        // `<=` would let NaN extents through.
+        if resolution == 0 || (0..D).any(|k| hi[k].partial_cmp(&lo[k]) != Some(std::cmp::Ordering::Greater)) {
             return Err(CnnError::EmptyMesh(format!(
                 "a grid of {resolution} cells per axis over the box {lo:?}–{hi:?} has no cells"
             )));

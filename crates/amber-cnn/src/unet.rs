@@ -62,7 +62,7 @@ impl UNetConfig {
 
 /// How parameters come into being: drawn from a seeded generator, or taken from a file.
 enum Source {
-    Seeded(ChaCha8Rng),
+    Seeded(Box<ChaCha8Rng>),
     File { path: std::path::PathBuf, tensors: HashMap<String, Tensor> },
 }
 
@@ -101,7 +101,11 @@ impl Params {
             }
         };
         let var = Var::from_tensor(&tensor.to_dtype(self.dtype)?)?;
-        self.varmap.data().lock().map_err(|_| CnnError::Shape("poisoned variable map".into()))?.insert(name.into(), var.clone());
+        self.varmap
+            .data()
+            .lock()
+            .map_err(|_| CnnError::Shape("poisoned variable map".into()))?
+            .insert(name.into(), var.clone());
         Ok(var)
     }
 
@@ -234,7 +238,7 @@ impl UNet {
 
     /// A freshly initialised network (parameters drawn from `seed`).
     pub fn init(config: UNetConfig, seed: u64, dtype: DType) -> Result<Self> {
-        Self::build(config, Source::Seeded(ChaCha8Rng::seed_from_u64(seed)), dtype)
+        Self::build(config, Source::Seeded(Box::new(ChaCha8Rng::seed_from_u64(seed))), dtype)
     }
 
     /// The network of a weights file written by [`Self::save`], with `config`.
@@ -341,9 +345,11 @@ mod tests {
     fn parameter_count_matches_the_reference_layout() {
         // PyTorch's 2D U-Net with 32 channels, depth 4, 4 inputs has 7,766,273 parameters; it
         // has a bias in each of the 18 convolutions followed by BatchNorm, which this one omits.
-        let net = UNet::init(UNetConfig { spatial_axes: 2, in_channels: 4, initial_channels: 32, depth: 4 }, 0, DType::F32)
-            .unwrap();
-        let biases: usize = [32, 32, 64, 64, 128, 128, 256, 256, 512, 512, 256, 256, 128, 128, 64, 64, 32, 32].iter().sum();
+        let net =
+            UNet::init(UNetConfig { spatial_axes: 2, in_channels: 4, initial_channels: 32, depth: 4 }, 0, DType::F32)
+                .unwrap();
+        let biases: usize =
+            [32, 32, 64, 64, 128, 128, 256, 256, 512, 512, 256, 256, 128, 128, 64, 64, 32, 32].iter().sum();
         assert_eq!(net.parameter_count() + biases, 7_766_273);
     }
 
@@ -360,7 +366,10 @@ mod tests {
         net.save(&path).unwrap();
         let loaded = UNet::load(config(2), &path, DType::F32).unwrap();
         let again = loaded.forward(&x).unwrap();
-        assert_eq!(again.flatten_all().unwrap().to_vec1::<f32>().unwrap(), after.flatten_all().unwrap().to_vec1::<f32>().unwrap());
+        assert_eq!(
+            again.flatten_all().unwrap().to_vec1::<f32>().unwrap(),
+            after.flatten_all().unwrap().to_vec1::<f32>().unwrap()
+        );
         let other = UNetConfig { initial_channels: 8, ..config(2) };
         assert!(matches!(UNet::load(other, &path, DType::F32), Err(CnnError::ModelFile { .. })));
     }

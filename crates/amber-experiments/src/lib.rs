@@ -16,7 +16,7 @@ mod table;
 
 pub use method::{Method, MethodSpec, Variant};
 pub use plots::{Bar, Series, Tile, bar_chart, line_chart, mesh_gallery};
-pub use poisson::{PoissonExperiment, train_poisson};
+pub use poisson::{PoissonExperiment, RunConfig, train_cnn_poisson, train_poisson};
 pub use progress::{TrainingProgress, item_bar};
 pub use report::{commit, config_hash, machine, merge_json, read_json, write_atomic, write_json};
 pub use results::{ExperimentResults, ProblemEvaluation, RunKey, RunResult, StepEvaluation};

@@ -9,47 +9,68 @@ use serde::{Deserialize, Serialize};
 
 /// A meshing method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[serde(into = "String", try_from = "String")]
 pub enum Method {
     /// AMBER with mean-projected labels.
     AmberMean,
     /// AMBER with max-projected labels.
     AmberMax,
+    /// The U-Net baseline (spec §8) on a `resolution`^d pixel grid.
+    Cnn { resolution: usize },
 }
 
 impl Method {
-    /// Every method, in table order.
-    pub const ALL: [Method; 2] = [Method::AmberMean, Method::AmberMax];
+    /// The methods an experiment runs unless told otherwise, in table order.
+    pub const DEFAULT: [Method; 2] = [Method::AmberMean, Method::AmberMax];
 
     /// The name used on the command line, in files and tables.
-    pub fn name(self) -> &'static str {
+    pub fn name(self) -> String {
         match self {
-            Method::AmberMean => "amber-mean",
-            Method::AmberMax => "amber-max",
+            Method::AmberMean => "amber-mean".into(),
+            Method::AmberMax => "amber-max".into(),
+            Method::Cnn { resolution } => format!("cnn-{resolution}"),
         }
     }
 
-    /// How AMBER's labels aggregate the expert sizes.
+    /// How the labels aggregate the expert sizes (the CNN's default is the mean).
     pub fn aggregation(self) -> Aggregation {
         match self {
-            Method::AmberMean => Aggregation::Mean,
             Method::AmberMax => Aggregation::Max,
+            Method::AmberMean | Method::Cnn { .. } => Aggregation::Mean,
         }
     }
 }
 
 impl fmt::Display for Method {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        f.write_str(&self.name())
+    }
+}
+
+impl From<Method> for String {
+    fn from(method: Method) -> String {
+        method.name()
+    }
+}
+
+impl TryFrom<String> for Method {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
     }
 }
 
 impl FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Method::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-            let known: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-            format!("unknown method `{s}` (known: {})", known.join(", "))
+        if let Some(r) = s.strip_prefix("cnn-") {
+            return match r.parse::<usize>() {
+                Ok(resolution) if resolution >= 16 && resolution.is_multiple_of(16) => Ok(Method::Cnn { resolution }),
+                _ => Err(format!("`{s}`: the CNN resolution must be a multiple of 16 (cnn-32, cnn-64, ..., cnn-512)")),
+            };
+        }
+        Method::DEFAULT.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            format!("unknown method `{s}` (known: amber-mean, amber-max, cnn-<resolution> such as cnn-256)")
         })
     }
 }
@@ -90,7 +111,7 @@ impl MethodSpec {
     /// The row label: the method name, plus the variant's unless it is the default.
     pub fn label(&self) -> String {
         match self.variant.name.as_str() {
-            "default" => self.method.name().to_string(),
+            "default" => self.method.name(),
             variant => format!("{} ({variant})", self.method.name()),
         }
     }
@@ -102,11 +123,12 @@ mod tests {
 
     #[test]
     fn method_names_round_trip_and_unknown_names_list_the_known() {
-        for m in Method::ALL {
+        for m in [Method::AmberMean, Method::AmberMax, Method::Cnn { resolution: 256 }] {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);
             assert_eq!(serde_json::to_value(m).unwrap(), serde_json::json!(m.name()));
         }
         let err = "amber-median".parse::<Method>().unwrap_err();
         assert!(err.contains("amber-median") && err.contains("amber-max"), "{err}");
+        assert!("cnn-100".parse::<Method>().unwrap_err().contains("multiple of 16"));
     }
 }

@@ -7,7 +7,10 @@ use std::time::Instant;
 
 use amber_mesh::{Mesh2, MeshData, write_mesh};
 use amber_tasks::poisson::{Difficulty, PoissonProblem, Split, load_split, read_split};
-use amber_train::{AmberModel, CONFIG_FILE, Evaluation, MODEL_DIR, Profile, Rollout, Training, TrainingConfig, TrainingObserver};
+use amber_train::{
+    AmberModel, CONFIG_FILE, CnnConfig, CnnModel, CnnObserver, CnnStepReport, CnnTraining, Evaluation, EvaluationSummary,
+    MODEL_DIR, Profile, Rollout, Training, TrainingConfig, TrainingObserver,
+};
 use anyhow::{Context, bail};
 use serde::{Deserialize, Serialize};
 
@@ -43,8 +46,10 @@ pub struct PoissonExperiment {
     pub test_set: Option<PathBuf>,
     /// Evaluate on the first this many test problems (default: the whole split).
     pub test_problems: Option<usize>,
-    /// Fields merged into every run's training config (a `--config` file).
+    /// Fields merged into every AMBER run's training config (a `--config` file).
     pub overrides: serde_json::Value,
+    /// Fields merged into every CNN run's config.
+    pub cnn_overrides: serde_json::Value,
     /// Retrain and re-evaluate even when cached.
     pub force: bool,
 }
@@ -63,7 +68,7 @@ impl PoissonExperiment {
             profile,
             difficulties,
             seeds,
-            methods: Method::ALL.into_iter().map(MethodSpec::plain).collect(),
+            methods: Method::DEFAULT.into_iter().map(MethodSpec::plain).collect(),
             data_root: PathBuf::from("data/poisson"),
             manifest: PathBuf::from("datasets/poisson.json"),
             runs_root: PathBuf::from("data/runs"),
@@ -71,6 +76,7 @@ impl PoissonExperiment {
             test_set: None,
             test_problems,
             overrides: serde_json::json!({}),
+            cnn_overrides: serde_json::json!({}),
             force: false,
         }
     }
@@ -78,8 +84,10 @@ impl PoissonExperiment {
     /// The ablations of spec §10 on Poisson hard (easy for `smoke`), each a variant of the same
     /// training code: AMBER-Mean and AMBER-Max as configured (their per-step curves are the
     /// generation-steps study), both with the CNN's log-MSE loss, AMBER-Max without the softplus
-    /// output, with uniformly random buffer additions, without input normalisation, and with
-    /// 5, 10, 50 and 100 training problems (20 is the default). Writes `results/ablate/`.
+    /// output, with uniformly random buffer additions, without input normalisation, with 5, 10,
+    /// 50 and 100 training problems (20 is the default); the 256² CNN with its log-MSE loss,
+    /// with MSE after a softplus, with plain MSE on raw sizes, and with max-aggregated labels.
+    /// Writes `results/ablate/`.
     pub fn ablation(profile: Profile) -> Self {
         let mut experiment = Self::new(profile);
         experiment.experiment = "ablate".into();
@@ -97,6 +105,13 @@ impl PoissonExperiment {
             variant(Method::AmberMax, "random-buffer", serde_json::json!({ "source_selection": "uniform" })),
             variant(Method::AmberMax, "no-input-normalisation", serde_json::json!({ "normalise_inputs": false })),
         ];
+        let cnn = Method::Cnn { resolution: if profile == Profile::Smoke { 32 } else { 256 } };
+        experiment.methods.extend([
+            MethodSpec::plain(cnn),
+            variant(cnn, "softplus-mse", serde_json::json!({ "loss": "softplus_mse", "normalise_labels": false })),
+            variant(cnn, "plain-mse", serde_json::json!({ "loss": "mse", "normalise_labels": false })),
+            variant(cnn, "max-labels", serde_json::json!({ "aggregation": "max" })),
+        ]);
         let default_problems = TrainingConfig::profile(profile).data.train_problems;
         let sizes: &[usize] = if profile == Profile::Smoke { &[1, 3] } else { &[5, 10, 50, 100] };
         for &n in sizes.iter().filter(|&&n| n != default_problems) {
@@ -109,20 +124,41 @@ impl PoissonExperiment {
         experiment
     }
 
-    /// The training config of one run: the profile's, with the method's labels, the variant's
-    /// and the user's overrides, the difficulty and the seed.
-    pub fn training_config(&self, spec: &MethodSpec, difficulty: Difficulty, seed: usize) -> anyhow::Result<TrainingConfig> {
-        let mut config = TrainingConfig::profile(self.profile);
-        config.aggregation = spec.method.aggregation();
-        config.data.difficulty = difficulty;
-        config.seed = seed as u64;
-        let mut value = serde_json::to_value(&config)?;
-        merge_json(&mut value, &self.overrides);
-        merge_json(&mut value, &spec.variant.overrides);
-        let config: TrainingConfig = serde_json::from_value(value)
-            .with_context(|| format!("the overrides of {} do not fit the training config", spec.label()))?;
-        config.validate()?;
-        Ok(config)
+    /// The configuration of one run: the profile's, with the method's labels, the variant's and
+    /// the user's overrides (AMBER runs: `overrides`, CNN runs: `cnn_overrides`), the difficulty
+    /// and the seed.
+    pub fn run_config(&self, spec: &MethodSpec, difficulty: Difficulty, seed: usize) -> anyhow::Result<RunConfig> {
+        fn patched<T: Serialize + serde::de::DeserializeOwned>(
+            base: &T,
+            overrides: [&serde_json::Value; 2],
+            spec: &MethodSpec,
+        ) -> anyhow::Result<T> {
+            let mut value = serde_json::to_value(base)?;
+            overrides.iter().for_each(|o| merge_json(&mut value, o));
+            serde_json::from_value(value)
+                .with_context(|| format!("the overrides of {} do not fit its configuration", spec.label()))
+        }
+        Ok(match spec.method {
+            Method::AmberMean | Method::AmberMax => {
+                let mut config = TrainingConfig::profile(self.profile);
+                config.aggregation = spec.method.aggregation();
+                config.data.difficulty = difficulty;
+                config.seed = seed as u64;
+                let config = patched(&config, [&self.overrides, &spec.variant.overrides], spec)?;
+                config.validate()?;
+                RunConfig::Amber(config)
+            }
+            Method::Cnn { resolution } => {
+                let mut config = CnnConfig::profile(self.profile);
+                config.resolution = resolution;
+                config.aggregation = spec.method.aggregation();
+                config.data.difficulty = difficulty;
+                config.seed = seed as u64;
+                let config = patched(&config, [&self.cnn_overrides, &spec.variant.overrides], spec)?;
+                config.validate()?;
+                RunConfig::Cnn(config)
+            }
+        })
     }
 
     /// Runs the experiment and writes its outputs under `out`.
@@ -138,16 +174,16 @@ impl PoissonExperiment {
             let mut rows = Vec::new();
             for seed in 0..self.seeds {
                 for spec in &self.methods {
-                    let config = self.training_config(spec, difficulty, seed)?;
-                    let run = AmberRun::new(self, spec, &config, &test_name)?;
+                    let config = self.run_config(spec, difficulty, seed)?;
+                    let run = Run::new(self, spec, &config, &test_name)?;
                     let evaluated = run.train_and_evaluate(self, &config, &test)?;
                     configs.push(serde_json::json!({
                         "method": spec.method, "variant": spec.variant.name, "difficulty": difficulty.name(),
-                        "seed": seed, "run_dir": run.dir, "training": config,
+                        "seed": seed, "run_dir": run.dir, "training": config.to_json()?,
                     }));
                     runs.push(RunResult::new(
                         RunKey {
-                            method: spec.method.name(),
+                            method: &spec.method.name(),
                             variant: &spec.variant.name,
                             difficulty: difficulty.name(),
                             seed,
@@ -157,7 +193,7 @@ impl PoissonExperiment {
                         &evaluated.problems,
                     ));
                     if seed == 0 && spec.variant.name == "default" {
-                        rows.push((spec.label(), run.gallery_meshes(config.inference_steps)?));
+                        rows.push((spec.label(), run.gallery_meshes(config.inference_steps())?));
                     }
                 }
             }
@@ -327,6 +363,10 @@ fn paper_number(row: &str, difficulty: &str) -> Option<f64> {
         "amber-max (10-problems)" => 0.213,
         "amber-max (50-problems)" => 0.175,
         "amber-max (100-problems)" => 0.169,
+        "cnn-256" => 0.215,
+        "cnn-256 (softplus-mse)" => 0.289,
+        "cnn-256 (plain-mse)" => 0.521,
+        "cnn-256 (max-labels)" => 0.242,
         _ => return None,
     })
 }
@@ -347,32 +387,75 @@ struct TrainingTime {
     finished: bool,
 }
 
+/// The configuration of one run of either kind of method.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunConfig {
+    Amber(TrainingConfig),
+    Cnn(CnnConfig),
+}
+
+impl RunConfig {
+    /// Generation steps of the method's rollouts (the CNN predicts once).
+    pub fn inference_steps(&self) -> usize {
+        match self {
+            RunConfig::Amber(c) => c.inference_steps,
+            RunConfig::Cnn(_) => 1,
+        }
+    }
+
+    fn difficulty(&self) -> Difficulty {
+        match self {
+            RunConfig::Amber(c) => c.data.difficulty,
+            RunConfig::Cnn(c) => c.data.difficulty,
+        }
+    }
+
+    fn seed(&self) -> u64 {
+        match self {
+            RunConfig::Amber(c) => c.seed,
+            RunConfig::Cnn(c) => c.seed,
+        }
+    }
+
+    /// The config as JSON, tagged with its kind.
+    pub fn to_json(&self) -> anyhow::Result<serde_json::Value> {
+        Ok(match self {
+            RunConfig::Amber(c) => serde_json::json!({ "amber": c }),
+            RunConfig::Cnn(c) => serde_json::json!({ "cnn": c }),
+        })
+    }
+}
+
 /// A run directory: `<runs>/poisson/<difficulty>/<method>[-<variant>]/seed<r>-<config hash>`.
-struct AmberRun {
+struct Run {
     dir: PathBuf,
     label: String,
     test_name: String,
     eval_dir: PathBuf,
 }
 
-impl AmberRun {
-    fn new(experiment: &PoissonExperiment, spec: &MethodSpec, config: &TrainingConfig, test_name: &str) -> anyhow::Result<Self> {
+impl Run {
+    fn new(experiment: &PoissonExperiment, spec: &MethodSpec, config: &RunConfig, test_name: &str) -> anyhow::Result<Self> {
         let name = match spec.variant.name.as_str() {
-            "default" => spec.method.name().to_string(),
+            "default" => spec.method.name(),
             variant => format!("{}-{variant}", spec.method.name()),
         };
-        let key = serde_json::json!({ "config": config, "manifest": read_json::<serde_json::Value>(&experiment.manifest)? });
+        let config_json = match config {
+            RunConfig::Amber(c) => serde_json::to_value(c)?,
+            RunConfig::Cnn(c) => serde_json::to_value(c)?,
+        };
+        let key = serde_json::json!({ "config": config_json, "manifest": read_json::<serde_json::Value>(&experiment.manifest)? });
         let dir = experiment
             .runs_root
             .join("poisson")
-            .join(config.data.difficulty.name())
+            .join(config.difficulty().name())
             .join(&name)
-            .join(format!("seed{}-{}", config.seed, config_hash(&key)));
+            .join(format!("seed{}-{}", config.seed(), config_hash(&key)));
         if experiment.force && dir.exists() {
             std::fs::remove_dir_all(&dir).with_context(|| format!("{}: cannot remove for --force", dir.display()))?;
         }
         let eval_dir = dir.join(format!("eval-{}", config_hash(&serde_json::json!(test_name))));
-        let label = format!("{} {} seed {}", spec.label(), config.data.difficulty, config.seed);
+        let label = format!("{} {} seed {}", spec.label(), config.difficulty(), config.seed());
         Ok(Self { dir, label, test_name: test_name.into(), eval_dir })
     }
 
@@ -381,7 +464,7 @@ impl AmberRun {
     fn train_and_evaluate(
         &self,
         experiment: &PoissonExperiment,
-        config: &TrainingConfig,
+        config: &RunConfig,
         test: &[PoissonProblem],
     ) -> anyhow::Result<CachedEvaluation> {
         let cache = self.eval_dir.join("evaluation.json");
@@ -390,23 +473,37 @@ impl AmberRun {
             println!("{}: reusing the evaluation in {}", self.label, cache.display());
             return Ok(cached);
         }
-        let train_seconds = train_poisson(config, &experiment.data_root, &experiment.manifest, &self.dir, &self.label)?;
-        let model = AmberModel::load(&self.dir.join(MODEL_DIR))?;
-        let started = Instant::now();
-        let evaluation = Evaluation::new(test, &model.predictor.limits)?;
-        let (rollouts, summary) = evaluation.run(&model.network, &model.predictor, config.inference_steps)?;
-        let eval_seconds = started.elapsed().as_secs_f64();
+        let (data, manifest) = (&experiment.data_root, &experiment.manifest);
+        let (train_seconds, eval_seconds, rollouts) = match config {
+            RunConfig::Amber(config) => {
+                let train_seconds = train_poisson(config, data, manifest, &self.dir, &self.label)?;
+                let model = AmberModel::load(&self.dir.join(MODEL_DIR))?;
+                let started = Instant::now();
+                let evaluation = Evaluation::new(test, &model.predictor.limits)?;
+                let (rollouts, _) = evaluation.run(&model.network, &model.predictor, config.inference_steps)?;
+                (train_seconds, started.elapsed().as_secs_f64(), rollouts)
+            }
+            RunConfig::Cnn(config) => {
+                let train_seconds = train_cnn_poisson(config, data, manifest, &self.dir, &self.label)?;
+                let model = CnnModel::load(&self.dir.join(MODEL_DIR))?;
+                let started = Instant::now();
+                let references = Evaluation::new(test, &model.predictor.limits)?.references;
+                let rollouts = model.rollouts(test, &references)?;
+                (train_seconds, started.elapsed().as_secs_f64(), rollouts)
+            }
+        };
         let problems: Vec<ProblemEvaluation> = rollouts
             .iter()
             .zip(test)
             .map(|(r, p)| ProblemEvaluation::of(r, p.expert_mesh.num_elements()))
             .collect();
         self.save_gallery_meshes(&rollouts)?;
+        let summary = EvaluationSummary::new(test, &rollouts);
         println!(
             "{}: test normalised DCD {:.3} after {} steps ({} problems, {:.0} s)",
             self.label,
             summary.final_normalised_dcd().unwrap_or(f64::NAN),
-            config.inference_steps,
+            config.inference_steps(),
             test.len(),
             eval_seconds
         );
@@ -473,16 +570,8 @@ pub fn train_poisson(
         }
         return Ok(time.seconds);
     }
-    let seed = config.seed as usize;
-    let difficulty = config.data.difficulty;
-    let load = |split, seed, count| -> anyhow::Result<Vec<PoissonProblem>> {
-        let bar = item_bar(&format!("{difficulty} {split} problems"), count);
-        let (problems, _) = load_split(data_root, manifest, difficulty, split, seed, Some(count), &|| bar.inc(1))?;
-        bar.finish_and_clear();
-        Ok(problems)
-    };
-    let train = load(Split::Train, seed, config.data.train_problems)?;
-    let val = load(Split::Val, 0, config.data.val_problems)?;
+    let train = load_problems(data_root, manifest, config.data.difficulty, Split::Train, config.seed as usize, config.data.train_problems)?;
+    let val = load_problems(data_root, manifest, config.data.difficulty, Split::Val, 0, config.data.val_problems)?;
     let mut training = Training::open(config.clone(), train, dir)?;
     let validation = Evaluation::new(&val, training.limits())?;
     let mut progress = TimedProgress {
@@ -507,6 +596,51 @@ pub fn train_poisson(
     Ok(time.seconds)
 }
 
+/// The first `count` problems of a split, generated first where missing (with a progress bar).
+fn load_problems(
+    data_root: &Path,
+    manifest: &Path,
+    difficulty: Difficulty,
+    split: Split,
+    seed: usize,
+    count: usize,
+) -> anyhow::Result<Vec<PoissonProblem>> {
+    let bar = item_bar(&format!("{difficulty} {split} problems"), count);
+    let (problems, _) = load_split(data_root, manifest, difficulty, split, seed, Some(count), &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    Ok(problems)
+}
+
+/// Trains the U-Net baseline on the Poisson task into `dir` (as [`train_poisson`] does AMBER):
+/// resumable, not retrained once finished; returns the training wall time.
+pub fn train_cnn_poisson(
+    config: &CnnConfig,
+    data_root: &Path,
+    manifest: &Path,
+    dir: &Path,
+    label: &str,
+) -> anyhow::Result<f64> {
+    let time_path = dir.join("training_time.json");
+    let mut time: TrainingTime = if time_path.exists() { read_json(&time_path)? } else { TrainingTime::default() };
+    if time.finished && dir.join(MODEL_DIR).exists() {
+        return Ok(time.seconds);
+    }
+    let train = load_problems(data_root, manifest, config.data.difficulty, Split::Train, config.seed as usize, config.data.train_problems)?;
+    let mut training = CnnTraining::open(config.clone(), train, dir)?;
+    let mut progress = TimedProgress {
+        inner: TrainingProgress::new(label, training.step(), config.steps),
+        time_path: time_path.clone(),
+        before: time.seconds,
+        started: Instant::now(),
+    };
+    training.run(dir, &mut progress)?;
+    progress.inner.finish();
+    time.seconds = progress.seconds();
+    time.finished = true;
+    write_json(&time_path, &time)?;
+    Ok(time.seconds)
+}
+
 /// The progress bar plus a record of the training wall time at every checkpoint, so the time
 /// of a resumed run counts its earlier sessions.
 struct TimedProgress {
@@ -519,6 +653,16 @@ struct TimedProgress {
 impl TimedProgress {
     fn seconds(&self) -> f64 {
         self.before + self.started.elapsed().as_secs_f64()
+    }
+}
+
+impl CnnObserver for TimedProgress {
+    fn step(&mut self, report: &CnnStepReport, total: u64) {
+        self.inner.cnn_step(report, total);
+    }
+
+    fn checkpoint(&mut self, step: u64, dir: &Path) {
+        TrainingObserver::checkpoint(self, step, dir);
     }
 }
 

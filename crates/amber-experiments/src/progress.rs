@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use amber_train::{EvaluationSummary, StepReport, TrainingObserver};
+use amber_train::{CnnStepReport, EvaluationSummary, StepReport, TrainingObserver};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Steps between progress lines when no bar can be drawn.
@@ -53,6 +53,31 @@ impl TrainingProgress {
     }
 }
 
+impl TrainingProgress {
+    /// After every gradient step of a CNN run.
+    pub fn cnn_step(&mut self, report: &CnnStepReport, total: u64) {
+        let w = &mut self.window;
+        w.steps += 1;
+        w.loss += report.loss;
+        w.seconds += report.seconds;
+        self.bar.set_position(report.step);
+        let every = if self.bar.is_hidden() { LOG_INTERVAL } else { 5 };
+        if w.steps >= every || report.step == total {
+            let message = format!("loss {:.4}, {:.2} s/step", w.loss / w.steps as f64, w.seconds / w.steps as f64);
+            self.window = Window::default();
+            self.report(report.step, total, message);
+        }
+    }
+
+    fn report(&self, step: u64, total: u64, message: String) {
+        if self.bar.is_hidden() {
+            self.println(&format!("step {step}/{total} ({:.0} s): {message}", self.started.elapsed().as_secs_f64()));
+        } else {
+            self.bar.set_message(message);
+        }
+    }
+}
+
 impl TrainingObserver for TrainingProgress {
     fn step(&mut self, report: &StepReport, total: u64) {
         let w = &mut self.window;
@@ -71,15 +96,7 @@ impl TrainingObserver for TrainingProgress {
                 report.buffer_depths
             );
             self.window = Window::default();
-            if self.bar.is_hidden() {
-                self.println(&format!(
-                    "step {}/{total} ({:.0} s): {message}",
-                    report.step,
-                    self.started.elapsed().as_secs_f64()
-                ));
-            } else {
-                self.bar.set_message(message);
-            }
+            self.report(report.step, total, message);
         }
     }
 

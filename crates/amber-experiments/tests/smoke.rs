@@ -21,6 +21,7 @@ fn smoke_profile_writes_every_output_and_reuses_its_runs() {
     experiment.data_root = dir.path().join("data/poisson");
     experiment.runs_root = dir.path().join("data/runs");
     experiment.out = dir.path().join("results/poisson");
+    experiment.methods.push(amber_experiments::MethodSpec::plain(amber_experiments::Method::Cnn { resolution: 32 }));
     let results = experiment.run().unwrap();
 
     // results.json is the schema the issue names, and what run() returned.
@@ -31,7 +32,7 @@ fn smoke_profile_writes_every_output_and_reuses_its_runs() {
     }
     assert_eq!(serde_json::from_value::<ExperimentResults>(value.clone()).unwrap(), results);
     let runs = value["runs"].as_array().unwrap();
-    assert_eq!(runs.len(), 2, "AMBER-Mean and AMBER-Max on easy, one seed");
+    assert_eq!(runs.len(), 3, "AMBER-Mean, AMBER-Max and the 32² CNN on easy, one seed");
     let fields = [
         "method", "variant", "difficulty", "seed", "ndcd", "ndcd_quantiles", "ndcd_per_step", "dcd", "dcd_initial",
         "dcd_reconstruction", "volume_difference", "elements", "expert_elements", "failed_steps", "train_seconds",
@@ -42,7 +43,8 @@ fn smoke_profile_writes_every_output_and_reuses_its_runs() {
         for key in fields {
             assert!(run.get(key).is_some(), "a run lacks `{key}`: {run}");
         }
-        assert_eq!(run["ndcd_per_step"].as_array().unwrap().len(), steps);
+        let cnn = run["method"].as_str().unwrap().starts_with("cnn");
+        assert_eq!(run["ndcd_per_step"].as_array().unwrap().len(), if cnn { 1 } else { steps });
         assert_eq!(run["test_problems"], 3);
         let ndcd = run["ndcd"].as_f64().unwrap();
         assert!(ndcd.is_finite(), "{run}");
@@ -53,7 +55,7 @@ fn smoke_profile_writes_every_output_and_reuses_its_runs() {
         assert!(run["train_seconds"].as_f64().unwrap() > 0.0);
     }
     let methods: Vec<&str> = runs.iter().map(|r| r["method"].as_str().unwrap()).collect();
-    assert_eq!(methods, ["amber-mean", "amber-max"]);
+    assert_eq!(methods, ["amber-mean", "amber-max", "cnn-32"]);
 
     // The table names every method with its numbers; the pictures are real PNGs.
     let table = std::fs::read_to_string(experiment.out.join("table.md")).unwrap();
@@ -62,8 +64,8 @@ fn smoke_profile_writes_every_output_and_reuses_its_runs() {
     }
     assert_eq!(png_size(&experiment.out.join("ndcd_bars.png")), (1000, 620));
     assert_eq!(png_size(&experiment.out.join("ndcd_per_step_easy.png")), (1000, 620));
-    // Two methods × two problems, steps 1, 2, T and the expert.
-    assert_eq!(png_size(&experiment.out.join("gallery_easy.png")), (4 * 420, 4 * 380));
+    // Three methods × two problems; steps 1, 2, T and the expert (the CNN: its one step).
+    assert_eq!(png_size(&experiment.out.join("gallery_easy.png")), (4 * 420, 6 * 380));
 
     // A rerun trains and evaluates nothing: the same numbers come back from the caches.
     let again = experiment.run().unwrap();
@@ -80,6 +82,7 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     experiment.out = dir.path().join("results/ablate");
     // Few steps: this checks the plumbing of every variant, not their quality.
     experiment.overrides = serde_json::json!({ "steps": 24, "checkpoint_interval": 12, "validation_interval": 0 });
+    experiment.cnn_overrides = serde_json::json!({ "steps": 4, "checkpoint_interval": 2 });
     let results = experiment.run().unwrap();
     assert_eq!(results.experiment, "ablate");
     let rows: Vec<String> = results.runs.iter().map(amber_experiments::row_label).collect();
@@ -93,6 +96,10 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
             "amber-max (no-softplus)",
             "amber-max (random-buffer)",
             "amber-max (no-input-normalisation)",
+            "cnn-32",
+            "cnn-32 (softplus-mse)",
+            "cnn-32 (plain-mse)",
+            "cnn-32 (max-labels)",
             "amber-max (1-problems)",
             "amber-max (3-problems)",
         ]
@@ -100,12 +107,18 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     // Each variant really changed its run's config.
     let configs = results.config["runs"].as_array().unwrap();
     let training = |k: usize| &configs[k]["training"];
-    assert_eq!(training(2)["objective"], "log");
-    assert_eq!(training(4)["objective"], "linear");
-    assert_eq!(training(5)["source_selection"], "uniform");
-    assert_eq!(training(6)["normalise_inputs"], false);
-    assert_eq!(training(8)["data"]["train_problems"], 3);
-    assert!(results.runs.iter().all(|r| r.ndcd.is_finite() && r.ndcd_per_step.len() == 3));
+    assert_eq!(training(2)["amber"]["objective"], "log");
+    assert_eq!(training(4)["amber"]["objective"], "linear");
+    assert_eq!(training(5)["amber"]["source_selection"], "uniform");
+    assert_eq!(training(6)["amber"]["normalise_inputs"], false);
+    assert_eq!(training(8)["cnn"]["loss"], "softplus_mse");
+    assert_eq!(training(9)["cnn"]["loss"], "mse");
+    assert_eq!(training(10)["cnn"]["aggregation"], "max");
+    assert_eq!(training(12)["amber"]["data"]["train_problems"], 3);
+    for run in &results.runs {
+        let steps = if run.method.starts_with("cnn") { 1 } else { 3 };
+        assert!(run.ndcd.is_finite() && run.ndcd_per_step.len() == steps, "{run:?}");
+    }
     let table = std::fs::read_to_string(experiment.out.join("table.md")).unwrap();
     assert!(table.contains("| amber-max (no-softplus) |"), "{table}");
     assert!(experiment.out.join("ndcd_bars.png").exists());

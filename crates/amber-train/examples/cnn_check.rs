@@ -29,7 +29,8 @@ fn main() -> anyhow::Result<()> {
     let lr: f64 = args.get(6).map(|s| s.parse()).transpose()?.unwrap_or(3e-4);
     let train = read_split(&data.join("train"))?;
     let val: Vec<_> = read_split(&data.join("val"))?.into_iter().take(val_count).collect();
-    let config = CnnConfig { resolution, steps, images_per_step: Some(images), learning_rate: lr, checkpoint_interval: 1000, ..CnnConfig::quick() };
+    let normalise_labels = args.get(7).is_none_or(|s| s == "1");
+    let config = CnnConfig { resolution, steps, images_per_step: Some(images), learning_rate: lr, normalise_labels, checkpoint_interval: 1000, ..CnnConfig::quick() };
     let t = Instant::now();
     let mut training = CnnTraining::new(config, train)?;
     println!("prepared in {:.1}s", t.elapsed().as_secs_f64());

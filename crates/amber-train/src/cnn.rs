@@ -29,8 +29,8 @@ use crate::inference::metrics;
 use crate::model::{read_json, write_json};
 use crate::optim::Adam;
 use crate::{
-    BufferEntry, DataConfig, MeshLimits, Problem, Profile, Reference, Rollout, RolloutStep, StepOutcome,
-    StepStatus, generation_step, labels,
+    BufferEntry, DataConfig, MeshLimits, Problem, Profile, Reference, Rollout, RolloutStep, StepOutcome, StepStatus,
+    generation_step, labels,
 };
 
 /// File of the U-Net weights (and BatchNorm statistics) inside a CNN model directory.
@@ -354,7 +354,12 @@ fn rollout<const D: usize, P: Problem<D>>(
             metrics: initial,
         },
     };
-    Ok(Rollout { initial, steps: vec![step], initial_dcd: reference.initial_dcd, reconstruction_dcd: reference.reconstruction_dcd })
+    Ok(Rollout {
+        initial,
+        steps: vec![step],
+        initial_dcd: reference.initial_dcd,
+        reconstruction_dcd: reference.reconstruction_dcd,
+    })
 }
 
 /// One gradient step of a CNN run.
@@ -502,7 +507,11 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         for (sample, _) in &samples {
             inputs.push(predictor.input(sample)?);
             for owner in &sample.raster.owners {
-                targets.push(if owner.is_some() { normalised.next().expect("one target per inside pixel") } else { 0.0 });
+                targets.push(if owner.is_some() {
+                    normalised.next().expect("one target per inside pixel")
+                } else {
+                    0.0
+                });
                 masks.push(if owner.is_some() { 1.0f32 } else { 0.0 });
             }
         }
@@ -517,11 +526,19 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
 
     /// A fresh run on `problems` with a network initialised from the seed.
     pub fn new(config: CnnConfig, problems: Vec<P>) -> Result<Self> {
-        let (network, predictor, images) = Self::prepare(&config, &problems, |p| {
-            Ok(UNet::init(p.network.clone(), config.seed, DType::F32)?)
-        })?;
+        let (network, predictor, images) =
+            Self::prepare(&config, &problems, |p| Ok(UNet::init(p.network.clone(), config.seed, DType::F32)?))?;
         let optimiser = Adam::new(network.varmap(), config.max_grad_norm)?;
-        Ok(Self { subset_rng: subset_stream(config.seed), config, problems, network, optimiser, predictor, images, step: 0 })
+        Ok(Self {
+            subset_rng: subset_stream(config.seed),
+            config,
+            problems,
+            network,
+            optimiser,
+            predictor,
+            images,
+            step: 0,
+        })
     }
 
     /// Resumes the newest checkpoint under `out_dir` if there is one (the configuration and
@@ -605,7 +622,8 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
             Some(index) => t.index_select(index, 0),
             None => Ok(t.clone()),
         };
-        let (inputs, targets, masks) = (pick(&self.images.inputs)?, pick(&self.images.targets)?, pick(&self.images.masks)?);
+        let (inputs, targets, masks) =
+            (pick(&self.images.inputs)?, pick(&self.images.targets)?, pick(&self.images.masks)?);
         let output = self.network.forward_train(&inputs)?;
         let loss = self.config.loss.loss(&output, &targets, &masks)?;
         let loss_value = f64::from(loss.to_scalar::<f32>()?);
@@ -674,11 +692,21 @@ mod tests {
 
     /// Poisson problems with small experts (8 refinement steps).
     fn poisson(seeds: &[u64]) -> Vec<PoissonProblem> {
-        seeds.iter().map(|&s| PoissonProblem::generate(s, 8, INITIAL_SIZE, &ExpertHeuristic::default()).unwrap()).collect()
+        seeds
+            .iter()
+            .map(|&s| PoissonProblem::generate(s, 8, INITIAL_SIZE, &ExpertHeuristic::default()).unwrap())
+            .collect()
     }
 
     fn tiny(steps: u64) -> CnnConfig {
-        CnnConfig { resolution: 16, initial_channels: 4, steps, checkpoint_interval: 5, learning_rate: 3e-3, ..CnnConfig::smoke() }
+        CnnConfig {
+            resolution: 16,
+            initial_channels: 4,
+            steps,
+            checkpoint_interval: 5,
+            learning_rate: 3e-3,
+            ..CnnConfig::smoke()
+        }
     }
 
     fn single_thread<T: Send>(f: impl FnOnce() -> T + Send) -> T {
@@ -697,7 +725,9 @@ mod tests {
         assert_eq!(partial, CnnConfig { resolution: 64, loss: CnnLoss::SoftplusMse, ..CnnConfig::quick() });
         assert!(CnnConfig { resolution: 40, ..CnnConfig::quick() }.validate().is_err());
         assert!(CnnConfig { images_per_step: Some(0), ..CnnConfig::quick() }.validate().is_err());
-        assert!(CnnConfig { loss: CnnLoss::SoftplusMse, normalise_labels: true, ..CnnConfig::quick() }.validate().is_err());
+        assert!(
+            CnnConfig { loss: CnnLoss::SoftplusMse, normalise_labels: true, ..CnnConfig::quick() }.validate().is_err()
+        );
     }
 
     #[test]
@@ -726,7 +756,9 @@ mod tests {
             again.run(straight.path(), &mut ()).unwrap();
             let weights = |dir: &Path| std::fs::read(dir.join(CNN_WEIGHTS_FILE)).unwrap();
             assert_eq!(weights(&model_dir), weights(&straight.path().join(crate::MODEL_DIR)));
-            assert!(CnnTraining::open(CnnConfig { seed: 1, ..config }, poisson(&[11, 12]), resumed_dir.path()).is_err());
+            assert!(
+                CnnTraining::open(CnnConfig { seed: 1, ..config }, poisson(&[11, 12]), resumed_dir.path()).is_err()
+            );
 
             // The saved model predicts like the live network; one step, finite metrics.
             let model = CnnModel::load(&model_dir).unwrap();
@@ -804,7 +836,8 @@ mod tests {
 
     #[test]
     fn voxel_grids_train_and_roll_out_with_the_same_code() {
-        let problems = vec![CubeProblem { initial: cube(1), expert: cube(3) }, CubeProblem { initial: cube(1), expert: cube(2) }];
+        let problems =
+            vec![CubeProblem { initial: cube(1), expert: cube(3) }, CubeProblem { initial: cube(1), expert: cube(2) }];
         let mut training = CnnTraining::new(tiny(3), problems).unwrap();
         assert_eq!(training.predictor().network.in_channels, 1);
         assert_eq!(training.predictor().network.spatial_axes, 3);

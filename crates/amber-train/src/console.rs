@@ -48,8 +48,10 @@ mod tests {
 
     /// The shipped data bundle, or `None` (with a message) when it is absent.
     fn shipped_data() -> Option<PathBuf> {
-        let candidates =
-            [Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"), "/work/shared/data/console".into()];
+        let candidates = [
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"),
+            "/work/shared/data/console".into(),
+        ];
         let found = candidates.into_iter().find(|p| p.join("train").is_dir());
         if found.is_none() {
             println!("skipping: the Console data (../shared/data/console) is not present");

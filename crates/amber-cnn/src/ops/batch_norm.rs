@@ -34,7 +34,11 @@ pub fn batch_norm_relu(
     let x = x.contiguous()?;
     let dims = x.dims();
     if dims.len() < 3 || gamma.dims() != [dims[1]] || beta.dims() != [dims[1]] {
-        bail!("batch_norm_relu: input {dims:?} needs gamma and beta of shape [C], got {:?} and {:?}", gamma.dims(), beta.dims());
+        bail!(
+            "batch_norm_relu: input {dims:?} needs gamma and beta of shape [C], got {:?} and {:?}",
+            gamma.dims(),
+            beta.dims()
+        );
     }
     let (channels, plane) = (dims[1], dims[2..].iter().product::<usize>());
     let count = dims[0] * plane;
@@ -167,8 +171,12 @@ impl CustomOp3 for BatchNormRelu {
     ) -> Result<(CpuStorage, Shape)> {
         let plane = xl.dims()[2..].iter().product();
         let storage = match float_dtype(self.name(), &[xs.dtype(), gs.dtype(), bs.dtype()])? {
-            DType::F32 => CpuStorage::F32(self.forward::<f32>(cpu_slice(xs, xl)?, cpu_slice(gs, gl)?, cpu_slice(bs, bl)?, plane)),
-            _ => CpuStorage::F64(self.forward::<f64>(cpu_slice(xs, xl)?, cpu_slice(gs, gl)?, cpu_slice(bs, bl)?, plane)),
+            DType::F32 => {
+                CpuStorage::F32(self.forward::<f32>(cpu_slice(xs, xl)?, cpu_slice(gs, gl)?, cpu_slice(bs, bl)?, plane))
+            }
+            _ => {
+                CpuStorage::F64(self.forward::<f64>(cpu_slice(xs, xl)?, cpu_slice(gs, gl)?, cpu_slice(bs, bl)?, plane))
+            }
         };
         Ok((storage, xl.shape().clone()))
     }
@@ -217,13 +225,17 @@ mod tests {
     /// The composition from stock candle ops (differentiable), with batch statistics.
     fn composed(x: &Tensor, gamma: &Tensor, beta: &Tensor) -> Result<Tensor> {
         let c = x.dim(1)?;
-        let shape: Vec<usize> = std::iter::once(1).chain(std::iter::once(c)).chain(std::iter::repeat_n(1, x.rank() - 2)).collect();
+        let shape: Vec<usize> =
+            std::iter::once(1).chain(std::iter::once(c)).chain(std::iter::repeat_n(1, x.rank() - 2)).collect();
         let axes: Vec<usize> = std::iter::once(0).chain(2..x.rank()).collect();
         let mean = x.mean_keepdim(axes.as_slice())?;
         let centred = x.broadcast_sub(&mean)?;
         let var = centred.sqr()?.mean_keepdim(axes.as_slice())?;
         let normalised = centred.broadcast_div(&(var + EPSILON)?.sqrt()?)?;
-        normalised.broadcast_mul(&gamma.reshape(shape.as_slice())?)?.broadcast_add(&beta.reshape(shape.as_slice())?)?.relu()
+        normalised
+            .broadcast_mul(&gamma.reshape(shape.as_slice())?)?
+            .broadcast_add(&beta.reshape(shape.as_slice())?)?
+            .relu()
     }
 
     fn inputs(dtype: DType) -> [Tensor; 3] {
@@ -235,9 +247,11 @@ mod tests {
     #[test]
     fn training_mode_matches_the_composition_forward_and_backward() {
         let probe = Image::random(3, 4, &[5, 3], 4);
-        let (expected, expected_grads) = forward_and_grads(&inputs(DType::F64), &probe, |t| composed(&t[0], &t[1], &t[2]));
+        let (expected, expected_grads) =
+            forward_and_grads(&inputs(DType::F64), &probe, |t| composed(&t[0], &t[1], &t[2]));
         for dtype in [DType::F64, DType::F32] {
-            let (y, grads) = forward_and_grads(&inputs(dtype), &probe, |t| Ok(batch_norm_relu(&t[0], &t[1], &t[2], None)?.0));
+            let (y, grads) =
+                forward_and_grads(&inputs(dtype), &probe, |t| Ok(batch_norm_relu(&t[0], &t[1], &t[2], None)?.0));
             assert_close(&y, &expected, 1e-5, "forward");
             for (g, e) in grads.iter().zip(&expected_grads) {
                 assert_close(g, e, 1e-4, "gradient");

@@ -30,7 +30,14 @@ pub fn conv(x: &Tensor, w: &Tensor) -> Result<Tensor> {
 /// `(O, C, k)` of a kernel tensor `(O, C, k, ..., k)` with `spatial_axes` equal odd sizes k.
 fn kernel_dims(dims: &[usize], spatial_axes: usize) -> Result<(usize, usize, usize)> {
     match dims {
-        [o, c, ks @ ..] if *o > 0 && *c > 0 && spatial_axes > 0 && ks.len() == spatial_axes && ks[0] % 2 == 1 && ks.iter().all(|&k| k == ks[0]) => {
+        [o, c, ks @ ..]
+            if *o > 0
+                && *c > 0
+                && spatial_axes > 0
+                && ks.len() == spatial_axes
+                && ks[0] % 2 == 1
+                && ks.iter().all(|&k| k == ks[0]) =>
+        {
             Ok((*o, *c, ks[0]))
         }
         _ => bail!("conv: the kernel must be (O, C) (both positive) plus {spatial_axes} equal odd sizes, got {dims:?}"),
@@ -143,12 +150,12 @@ fn forward<T: Float>(x: &[T], w: &[T], n: usize, c: usize, o: usize, unfold: &Un
     let tile_rows = unfold.tile_rows(c);
     let tiles = unfold.rows.div_ceil(tile_rows);
     let dst = SharedMut(out.spare_capacity_mut().as_mut_ptr().cast::<T>());
-    for_each_item(n * tiles, |item, threads| {
+    for_each_item(n * tiles, |item, threads, scratch| {
         let (image, tile) = (item / tiles, item % tiles);
         let rows = tile * tile_rows..((tile + 1) * tile_rows).min(unfold.rows);
         let (start, width) = (rows.start * unfold.row_len, rows.len() * unfold.row_len);
-        let mut cols = vec![T::zero(); c * taps * width];
-        unfold.im2col(&x[image * c * p..(image + 1) * c * p], c, rows, &mut cols);
+        let cols = scratch.take(c * taps * width);
+        unfold.im2col(&x[image * c * p..(image + 1) * c * p], c, rows, cols);
         // SAFETY: this item writes only columns [start, start + width) of image `image`'s
         // (O × P) output block, disjoint from every other item; operands are in bounds.
         unsafe {
@@ -160,7 +167,7 @@ fn forward<T: Float>(x: &[T], w: &[T], n: usize, c: usize, o: usize, unfold: &Un
                 p,
                 false,
                 Strided::row_major(w, c * taps),
-                Strided::row_major(&cols, width),
+                Strided::row_major(cols, width),
                 threads,
             );
         }
@@ -175,16 +182,26 @@ fn weight_grad<T: Float>(x: &[T], dy: &[T], n: usize, c: usize, o: usize, unfold
     let (p, taps) = (unfold.positions(), unfold.taps());
     let tile_rows = unfold.tile_rows(c);
     let tiles = unfold.rows.div_ceil(tile_rows);
-    sum_over_items(n * tiles, o * c * taps, |item, threads, acc: &mut [T]| {
+    sum_over_items(n * tiles, o * c * taps, |item, threads, acc: &mut [T], scratch| {
         let (image, tile) = (item / tiles, item % tiles);
         let rows = tile * tile_rows..((tile + 1) * tile_rows).min(unfold.rows);
         let (start, width) = (rows.start * unfold.row_len, rows.len() * unfold.row_len);
-        let mut cols = vec![T::zero(); c * taps * width];
-        unfold.im2col(&x[image * c * p..(image + 1) * c * p], c, rows, &mut cols);
+        let cols = scratch.take(c * taps * width);
+        unfold.im2col(&x[image * c * p..(image + 1) * c * p], c, rows, cols);
         let dy = Strided { ptr: dy[image * o * p + start..].as_ptr(), rows: p as isize, cols: 1 };
         // SAFETY: `acc` is this item's own accumulator; operands are in bounds.
         unsafe {
-            matmul(o, c * taps, width, acc.as_mut_ptr(), c * taps, true, dy, Strided::transposed(&cols, width), threads);
+            matmul(
+                o,
+                c * taps,
+                width,
+                acc.as_mut_ptr(),
+                c * taps,
+                true,
+                dy,
+                Strided::transposed(cols, width),
+                threads,
+            );
         }
     })
 }

@@ -37,7 +37,9 @@ impl Blocks {
         let (n, c, spatial) = image_dims("conv_transpose2", x, x.len().saturating_sub(2))?;
         let axes = spatial.len();
         if w.len() != axes + 2 || w[0] != c || c == 0 || w[1] == 0 || w[2..].iter().any(|&k| k != 2) || b != [w[1]] {
-            bail!("conv_transpose2: input {x:?}, kernel {w:?} and bias {b:?} do not fit (kernel (C, O, 2, ...), bias (O))");
+            bail!(
+                "conv_transpose2: input {x:?}, kernel {w:?} and bias {b:?} do not fit (kernel (C, O, 2, ...), bias (O))"
+            );
         }
         let out: Vec<usize> = spatial.iter().map(|s| 2 * s).collect();
         let mut out_strides = vec![1; axes];
@@ -83,11 +85,11 @@ fn forward<T: Float>(x: &[T], w: &[T], bias: &[T], blocks: &Blocks) -> Vec<T> {
     let mut out: Vec<T> = Vec::with_capacity(blocks.n * o * out_p);
     let (width, tiles) = blocks.tiling();
     let dst = SharedMut(out.spare_capacity_mut().as_mut_ptr().cast::<T>());
-    super::gemm::for_each_item(blocks.n * tiles, |item, threads| {
+    super::gemm::for_each_item(blocks.n * tiles, |item, threads, scratch| {
         let (image, tile) = (item / tiles, item % tiles);
         let range = tile * width..((tile + 1) * width).min(p);
         let t = range.len();
-        let mut z = vec![T::zero(); o * k * t];
+        let z = scratch.take(o * k * t);
         let xs = Strided { ptr: x[image * c * p + range.start..].as_ptr(), rows: p as isize, cols: 1 };
         // SAFETY: `z` is this item's own; operands are in bounds.
         unsafe { matmul(o * k, t, c, z.as_mut_ptr(), t, false, Strided::transposed(w, o * k), xs, threads) };
@@ -115,11 +117,11 @@ fn backward<T: Float>(x: &[T], w: &[T], dy: &[T], blocks: &Blocks, want_dx: bool
     let mut dx = want_dx.then(|| vec![T::zero(); blocks.n * c * p]);
     let dx_ptr = SharedMut(dx.as_mut().map_or(std::ptr::null_mut(), |d| d.as_mut_ptr()));
     let (width, tiles) = blocks.tiling();
-    let dw = sum_over_items(blocks.n * tiles, c * o * k, |item, threads, acc: &mut [T]| {
+    let dw = sum_over_items(blocks.n * tiles, c * o * k, |item, threads, acc: &mut [T], scratch| {
         let (image, tile) = (item / tiles, item % tiles);
         let range = tile * width..((tile + 1) * width).min(p);
         let t = range.len();
-        let mut dz = vec![T::zero(); o * k * t];
+        let dz = scratch.take(o * k * t);
         for oi in 0..o {
             let plane = &dy[image * o * out_p + oi * out_p..][..out_p];
             for (s, &offset) in blocks.offsets.iter().enumerate() {
@@ -143,9 +145,8 @@ fn backward<T: Float>(x: &[T], w: &[T], dy: &[T], blocks: &Blocks, want_dx: bool
     let db = (0..o)
         .into_par_iter()
         .map(|oi| {
-            (0..blocks.n).fold(T::zero(), |sum, image| {
-                dy[(image * o + oi) * out_p..][..out_p].iter().fold(sum, |s, &v| s + v)
-            })
+            (0..blocks.n)
+                .fold(T::zero(), |sum, image| dy[(image * o + oi) * out_p..][..out_p].iter().fold(sum, |s, &v| s + v))
         })
         .collect();
     (dx, dw, db)
@@ -166,10 +167,11 @@ impl CustomOp3 for ConvTranspose2 {
         bl: &Layout,
     ) -> Result<(CpuStorage, Shape)> {
         let blocks = Blocks::new(xl.dims(), wl.dims(), bl.dims())?;
-        let dims: Vec<usize> =
-            [blocks.n, blocks.o].into_iter().chain(xl.dims()[2..].iter().map(|s| 2 * s)).collect();
+        let dims: Vec<usize> = [blocks.n, blocks.o].into_iter().chain(xl.dims()[2..].iter().map(|s| 2 * s)).collect();
         let storage = match float_dtype(self.name(), &[xs.dtype(), ws.dtype(), bs.dtype()])? {
-            DType::F32 => CpuStorage::F32(forward::<f32>(cpu_slice(xs, xl)?, cpu_slice(ws, wl)?, cpu_slice(bs, bl)?, &blocks)),
+            DType::F32 => {
+                CpuStorage::F32(forward::<f32>(cpu_slice(xs, xl)?, cpu_slice(ws, wl)?, cpu_slice(bs, bl)?, &blocks))
+            }
             _ => CpuStorage::F64(forward::<f64>(cpu_slice(xs, xl)?, cpu_slice(ws, wl)?, cpu_slice(bs, bl)?, &blocks)),
         };
         Ok((storage, Shape::from(dims)))
@@ -198,8 +200,9 @@ fn run_backward<T: Float>(
     grad: &Tensor,
     blocks: &Blocks,
 ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-    let (dx, dw, db) =
-        with_slice(x, |xv| with_slice(w, |wv| with_slice(grad, |g| Ok(backward::<T>(xv, wv, g, blocks, x.track_op())))))?;
+    let (dx, dw, db) = with_slice(x, |xv| {
+        with_slice(w, |wv| with_slice(grad, |g| Ok(backward::<T>(xv, wv, g, blocks, x.track_op()))))
+    })?;
     let dx = dx.map(|dx| Tensor::from_vec(dx, x.shape(), x.device())).transpose()?;
     Ok((dx, Some(Tensor::from_vec(dw, w.shape(), w.device())?), Some(Tensor::from_vec(db, b.shape(), b.device())?)))
 }

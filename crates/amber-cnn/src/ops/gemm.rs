@@ -73,37 +73,64 @@ pub(super) unsafe fn matmul<T: Float>(
     }
 }
 
-/// Runs `work(item, threads_for_its_matmuls)` for every item: items in parallel with
+/// Scratch memory of one worker, reused from item to item (zero-filled only when it grows, and
+/// every user overwrites what it reads).
+pub(super) struct Scratch<T>(Vec<T>);
+
+impl<T: Float> Scratch<T> {
+    fn new() -> Self {
+        Self(Vec::new())
+    }
+
+    /// The first `len` elements, grown if needed.
+    pub fn take(&mut self, len: usize) -> &mut [T] {
+        if self.0.len() < len {
+            self.0.resize(len, T::zero());
+        }
+        &mut self.0[..len]
+    }
+}
+
+/// Runs `work(item, threads_for_its_matmuls, scratch)` for every item: items in parallel with
 /// single-threaded products when there are enough of them to keep every thread busy, else one
 /// after the other with multi-threaded products (the deep, small levels of a U-Net).
-pub(super) fn for_each_item(items: usize, work: impl Fn(usize, usize) + Sync) {
+pub(super) fn for_each_item<T: Float>(items: usize, work: impl Fn(usize, usize, &mut Scratch<T>) + Sync) {
     let threads = rayon::current_num_threads();
     if items >= 2 * threads {
-        (0..items).into_par_iter().for_each(|i| work(i, 1));
+        (0..items).into_par_iter().for_each_init(Scratch::new, |scratch, i| work(i, 1, scratch));
     } else {
-        (0..items).for_each(|i| work(i, threads));
+        let mut scratch = Scratch::new();
+        (0..items).for_each(|i| work(i, threads, &mut scratch));
     }
 }
 
 /// Like [`for_each_item`], but every item adds into an accumulator of `len` zeros; returns the
 /// sum of all accumulators.
-pub(super) fn sum_over_items<T: Float>(items: usize, len: usize, work: impl Fn(usize, usize, &mut [T]) + Sync) -> Vec<T> {
+pub(super) fn sum_over_items<T: Float>(
+    items: usize,
+    len: usize,
+    work: impl Fn(usize, usize, &mut [T], &mut Scratch<T>) + Sync,
+) -> Vec<T> {
     let threads = rayon::current_num_threads();
     let zeros = || vec![T::zero(); len];
     if items >= 2 * threads {
         (0..items)
             .into_par_iter()
-            .fold(zeros, |mut acc, i| {
-                work(i, 1, &mut acc);
-                acc
-            })
+            .fold(
+                || (zeros(), Scratch::new()),
+                |(mut acc, mut scratch), i| {
+                    work(i, 1, &mut acc, &mut scratch);
+                    (acc, scratch)
+                },
+            )
+            .map(|(acc, _)| acc)
             .reduce(zeros, |mut a, b| {
                 a.iter_mut().zip(&b).for_each(|(a, &b)| *a += b);
                 a
             })
     } else {
-        let mut acc = zeros();
-        (0..items).for_each(|i| work(i, threads, &mut acc));
+        let (mut acc, mut scratch) = (zeros(), Scratch::new());
+        (0..items).for_each(|i| work(i, threads, &mut acc, &mut scratch));
         acc
     }
 }

@@ -53,9 +53,7 @@ fn with_slice<T: Float, R>(t: &Tensor, f: impl FnOnce(&[T]) -> Result<R>) -> Res
 /// The common float dtype of an op's inputs.
 fn float_dtype(op: &str, dtypes: &[DType]) -> Result<DType> {
     match dtypes {
-        [first, rest @ ..] if matches!(first, DType::F32 | DType::F64) && rest.iter().all(|d| d == first) => {
-            Ok(*first)
-        }
+        [first, rest @ ..] if matches!(first, DType::F32 | DType::F64) && rest.iter().all(|d| d == first) => Ok(*first),
         _ => bail!("{op}: inputs must be all f32 or all f64, got {dtypes:?}"),
     }
 }

@@ -154,7 +154,8 @@ mod tests {
                     let corner: Vec<isize> = y.index(o).iter().map(|&i| 2 * i as isize).collect();
                     let mut best: Option<(f64, usize)> = None;
                     for bits in 0..1usize << axes {
-                        let at: Vec<isize> = (0..axes).map(|a| corner[a] + ((bits >> (axes - 1 - a)) & 1) as isize).collect();
+                        let at: Vec<isize> =
+                            (0..axes).map(|a| corner[a] + ((bits >> (axes - 1 - a)) & 1) as isize).collect();
                         let q = x.flat(&at).unwrap();
                         if best.is_none_or(|(b, _)| x.get(n, c, q) > b) {
                             best = Some((x.get(n, c, q), q));

@@ -367,8 +367,12 @@ mod tests {
         let vertices = [v, shifted].concat();
         let triangles = [t.clone(), t.iter().map(|tri| tri.map(|i| i + n)).collect()].concat();
         let faces = [ids.clone(), ids.iter().map(|f| f + 6).collect()].concat();
-        let err = generate_3d(&Surface::new(vertices, triangles, faces).unwrap(), &ConstantSize(0.2), &Mesh3dParams::default())
-            .unwrap_err();
+        let err = generate_3d(
+            &Surface::new(vertices, triangles, faces).unwrap(),
+            &ConstantSize(0.2),
+            &Mesh3dParams::default(),
+        )
+        .unwrap_err();
         assert!(matches!(err, Mesh3dError::InvalidSurface(SurfaceDefect::SelfIntersection { .. })), "{err}");
     }
 
@@ -406,7 +410,8 @@ mod tests {
         let start = std::time::Instant::now();
         let mesh = generate_3d(&reference, &field, &Mesh3dParams::default()).unwrap();
         let ratio = mesh.num_elements() as f64 / expert.num_elements() as f64;
-        let mut sizes: Vec<f64> = (0..mesh.num_elements()).map(|e| mesh.size(e) / field.size_at(mesh.midpoint(e))).collect();
+        let mut sizes: Vec<f64> =
+            (0..mesh.num_elements()).map(|e| mesh.size(e) / field.size_at(mesh.midpoint(e))).collect();
         sizes.sort_by(f64::total_cmp);
         let median = sizes[sizes.len() / 2];
         let min_dihedral = mesh.min_angles().into_iter().fold(f64::INFINITY, f64::min);

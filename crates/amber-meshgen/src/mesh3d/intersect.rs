@@ -19,7 +19,9 @@ type Triangle = [[f64; 3]; 3];
 /// end of the intersection segment lies on an edge of one of them; if they are coplanar, either
 /// edges cross or one triangle holds an edge of the other.
 pub(crate) fn triangles_intersect(t: &Triangle, u: &Triangle) -> bool {
-    !clearly_apart(t, u) && (0..3).any(|i| segment_meets_triangle(t[i], t[(i + 1) % 3], u) || segment_meets_triangle(u[i], u[(i + 1) % 3], t))
+    !clearly_apart(t, u)
+        && (0..3)
+            .any(|i| segment_meets_triangle(t[i], t[(i + 1) % 3], u) || segment_meets_triangle(u[i], u[(i + 1) % 3], t))
 }
 
 /// Whether the closed segment [p, q] meets the closed triangle `t`.
@@ -82,7 +84,9 @@ fn clearly_apart(p: &[[f64; 3]], q: &[[f64; 3]]) -> bool {
             return false;
         }
         let range = |x: &[[f64; 3]]| {
-            x.iter().map(|&v| dot(axis, v)).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
+            x.iter()
+                .map(|&v| dot(axis, v))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
         };
         let ((plo, phi), (qlo, qhi)) = (range(p), range(q));
         // Rounding in the dot products is a few ulps of length × scale; 1e-10 is far above it.
@@ -159,13 +163,14 @@ pub(crate) fn triangle_box(c: &Triangle) -> AABB<[f64; 3]> {
     AABB::from_corners(lo, hi)
 }
 
-/// A uniform grid of triangle bounding boxes, each tagged with the triangle's index (cells
-/// twice as large as the mean box, hashed). Entries are only added: callers re-insert a
-/// triangle whose corners changed and check candidates against its current corners, so stale
-/// boxes cost a little time and never hide a triangle.
+/// A uniform grid of triangle bounding boxes (cells twice as large as the mean box, hashed),
+/// holding each triangle's latest box. Re-inserting a triangle whose corners changed records
+/// its new box and cells; the old cells keep listing it, which costs a little time and never
+/// hides a triangle (candidates are filtered by the latest box).
 pub(crate) struct TriangleIndex {
     cell: f64,
-    cells: HashMap<[i64; 3], Vec<(u32, AABB<[f64; 3]>)>, BuildHasherDefault<CellHasher>>,
+    boxes: Vec<Option<AABB<[f64; 3]>>>,
+    cells: HashMap<[i64; 3], Vec<u32>, BuildHasherDefault<CellHasher>>,
 }
 
 impl TriangleIndex {
@@ -176,7 +181,8 @@ impl TriangleIndex {
         // Twice the mean: most boxes then touch at most two cells per axis, also after the
         // remesher has made triangles larger.
         let cell = if mean.is_finite() && mean > 0.0 { 2.0 * mean } else { 1.0 };
-        let mut index = Self { cell, cells: HashMap::default() };
+        let mut index = Self { cell, boxes: Vec::new(), cells: HashMap::default() };
+        index.cells.reserve(boxes.len());
         boxes.into_iter().for_each(|(t, b)| index.insert(t, b));
         index
     }
@@ -188,17 +194,24 @@ impl TriangleIndex {
     }
 
     pub(crate) fn insert(&mut self, t: u32, b: AABB<[f64; 3]>) {
+        if self.boxes.len() <= t as usize {
+            self.boxes.resize(t as usize + 1, None);
+        }
+        self.boxes[t as usize] = Some(b);
         let (lo, hi) = self.range(&b);
         for i in lo[0]..=hi[0] {
             for j in lo[1]..=hi[1] {
                 for k in lo[2]..=hi[2] {
-                    self.cells.entry([i, j, k]).or_default().push((t, b));
+                    let cell = self.cells.entry([i, j, k]).or_default();
+                    if cell.last() != Some(&t) {
+                        cell.push(t);
+                    }
                 }
             }
         }
     }
 
-    /// Indices whose (possibly stale) box meets `b`, each once, sorted.
+    /// Indices whose latest box meets `b`, each once, sorted.
     pub(crate) fn candidates(&self, b: AABB<[f64; 3]>) -> Vec<u32> {
         let (lo, hi) = self.range(&b);
         let mut c = Vec::new();
@@ -206,7 +219,12 @@ impl TriangleIndex {
             for j in lo[1]..=hi[1] {
                 for k in lo[2]..=hi[2] {
                     if let Some(entries) = self.cells.get(&[i, j, k]) {
-                        c.extend(entries.iter().filter(|(_, e)| e.intersects(&b)).map(|&(t, _)| t));
+                        c.extend(
+                            entries
+                                .iter()
+                                .copied()
+                                .filter(|&t| self.boxes[t as usize].is_some_and(|e| e.intersects(&b))),
+                        );
                     }
                 }
             }

@@ -14,7 +14,7 @@
 use std::collections::{BTreeMap, HashMap};
 
 use rstar::primitives::Line;
-use rstar::{AABB, PointDistance, RTree, RTreeObject};
+use rstar::{AABB, Envelope, PointDistance, RTree, RTreeObject};
 
 use super::intersect::{TriangleIndex, triangle_box, triangles_intersect, triangles_overlap};
 use super::surface::{Surface, SurfaceDefect};
@@ -123,6 +123,7 @@ fn kind_of(faces: &mut Vec<i32>) -> Kind {
 /// faces (most of a sheet-metal part) project onto their plane: a vertex inside a planar face
 /// whose triangles keep their orientation cannot leave the face, so the plane is enough.
 struct Projector {
+    /// The triangles of every curved face.
     faces: HashMap<i32, RTree<RefTriangle>>,
     /// Point and unit normal of every planar face.
     planes: HashMap<i32, ([f64; 3], [f64; 3])>,
@@ -149,9 +150,14 @@ impl Projector {
                 curves.entry((f.min(g), f.max(g))).or_default().push(Line::new(v[a as usize], v[b as usize]));
             }
         }
-        let planes = faces.iter().filter_map(|(&id, tris)| Some((id, plane_of(tris)?))).collect();
+        let planes: HashMap<i32, ([f64; 3], [f64; 3])> =
+            faces.iter().filter_map(|(&id, tris)| Some((id, plane_of(tris)?))).collect();
         Self {
-            faces: faces.into_iter().map(|(id, tris)| (id, RTree::bulk_load(tris))).collect(),
+            faces: faces
+                .into_iter()
+                .filter(|(id, _)| !planes.contains_key(id))
+                .map(|(id, tris)| (id, RTree::bulk_load(tris)))
+                .collect(),
             planes,
             curves: curves.into_iter().map(|(key, lines)| (key, RTree::bulk_load(lines))).collect(),
         }
@@ -354,7 +360,8 @@ impl WorkMesh {
                 if self.length(a, b) > 4.0 / 3.0 * self.edge_size(a, b)
                     && let Some(m) = self.split(a, b, context)?
                 {
-                    let safe_of = |v: u32| if v < first_new { self.pos[v as usize] } else { safe[(v - first_new) as usize] };
+                    let safe_of =
+                        |v: u32| if v < first_new { self.pos[v as usize] } else { safe[(v - first_new) as usize] };
                     let (p, q) = (safe_of(a), safe_of(b));
                     safe.push([0, 1, 2].map(|k| 0.5 * (p[k] + q[k])));
                     created.push(m);
@@ -398,7 +405,8 @@ impl WorkMesh {
         let keeps_side = halves.iter().all(|&(t, x, y, c)| {
             let old = self.normal(self.triangles[t as usize]);
             let [px, py, pc] = [x, y, c].map(|v| self.pos[v as usize]);
-            dot(cross(sub(projected, px), sub(pc, px)), old) > 0.0 && dot(cross(sub(py, projected), sub(pc, projected)), old) > 0.0
+            dot(cross(sub(projected, px), sub(pc, px)), old) > 0.0
+                && dot(cross(sub(py, projected), sub(pc, projected)), old) > 0.0
         });
         let at = if keeps_side { projected } else { mid };
         let m = self.pos.len() as u32;
@@ -458,7 +466,13 @@ impl WorkMesh {
     /// Whether vertex `from` may be merged into `to`: CAD structure kept, topology stays a
     /// closed manifold (link condition), no triangle turns over or degenerates, no new edge is
     /// too long or strays from the reference, no new triangle crosses another.
-    fn collapse_allowed<S: SizingField<3>>(&self, from: u32, to: u32, context: &Context<S>, index: &TriangleIndex) -> bool {
+    fn collapse_allowed<S: SizingField<3>>(
+        &self,
+        from: u32,
+        to: u32,
+        context: &Context<S>,
+        index: &TriangleIndex,
+    ) -> bool {
         let Some([t1, t2]) = self.edge_triangles(from, to) else { return false };
         let structure_kept = match self.kind[from as usize] {
             Kind::Corner => false,
@@ -483,7 +497,8 @@ impl WorkMesh {
             .filter(|(_, tri)| !tri.contains(&to))
             .map(|(t, tri)| (t, tri.map(|v| if v == from { to } else { v })))
             .collect();
-        let new_edges: Vec<u32> = n_from.iter().copied().filter(|&x| x != to && n_to.binary_search(&x).is_err()).collect();
+        let new_edges: Vec<u32> =
+            n_from.iter().copied().filter(|&x| x != to && n_to.binary_search(&x).is_err()).collect();
         // Cheap checks first: lengths, orientation and shape.
         if new_edges.iter().any(|&x| self.length(x, to) > 4.0 / 3.0 * self.edge_size(x, to)) {
             return false;
@@ -503,8 +518,8 @@ impl WorkMesh {
         }
         // Inside planar faces, triangles that keep their orientation cannot cross anything.
         let around = &self.around[from as usize];
-        around.iter().all(|&t| context.projector.is_planar(self.face[t as usize]))
-            || !moved.iter().any(|&(_, new)| self.crosses(index, new, around))
+        let new: Vec<[u32; 3]> = moved.iter().map(|&(_, tri)| tri).collect();
+        around.iter().all(|&t| context.projector.is_planar(self.face[t as usize])) || !self.crosses(index, &new, around)
     }
 
     /// Merges `from` into `to`; returns the triangles that changed corners.
@@ -567,7 +582,7 @@ impl WorkMesh {
             let kind = Kind::Face(self.face[t1 as usize]);
             let curved = !context.projector.is_planar(self.face[t1 as usize]);
             if !context.follows_reference(self.pos[c as usize], self.pos[d as usize], kind, self.edge_size(c, d))
-                || curved && (self.crosses(&index, new1, &[t1, t2]) || self.crosses(&index, new2, &[t1, t2]))
+                || curved && self.crosses(&index, &[new1, new2], &[t1, t2])
             {
                 continue;
             }
@@ -601,7 +616,9 @@ impl WorkMesh {
                 .into_iter()
                 .filter(|&x| {
                     matches!(kind, Kind::Face(_))
-                        || self.edge_triangles(v, x).is_some_and(|[s, t]| self.face[s as usize] != self.face[t as usize])
+                        || self
+                            .edge_triangles(v, x)
+                            .is_some_and(|[s, t]| self.face[s as usize] != self.face[t as usize])
                 })
                 .collect();
             if neighbours.is_empty() {
@@ -621,8 +638,10 @@ impl WorkMesh {
                 }
             }
             let target = context.projector.project(add(p, step), kind);
-            let before: Vec<([f64; 3], f64)> =
-                around.iter().map(|&t| (self.normal(self.triangles[t as usize]), self.quality(self.triangles[t as usize]))).collect();
+            let before: Vec<([f64; 3], f64)> = around
+                .iter()
+                .map(|&t| (self.normal(self.triangles[t as usize]), self.quality(self.triangles[t as usize])))
+                .collect();
             self.pos[v as usize] = target;
             let acceptable = around.iter().zip(&before).all(|(&t, &(normal, q))| {
                 let tri = self.triangles[t as usize];
@@ -660,15 +679,23 @@ impl WorkMesh {
         )
     }
 
-    /// Whether a triangle with corners `tri` would cross a live triangle other than the
-    /// `replaced` ones.
-    fn crosses(&self, index: &TriangleIndex, tri: [u32; 3], replaced: &[u32]) -> bool {
-        let corners = tri.map(|v| self.pos[v as usize]);
-        index.candidates(triangle_box(&corners)).into_iter().any(|u| {
+    /// Whether any of the triangles `new` would cross a live triangle other than the
+    /// `replaced` ones (one index query for all of them).
+    fn crosses(&self, index: &TriangleIndex, new: &[[u32; 3]], replaced: &[u32]) -> bool {
+        let corners: Vec<[[f64; 3]; 3]> = new.iter().map(|tri| tri.map(|v| self.pos[v as usize])).collect();
+        let boxes: Vec<AABB<[f64; 3]>> = corners.iter().map(triangle_box).collect();
+        let all = boxes.iter().fold(AABB::new_empty(), |acc: AABB<[f64; 3]>, b| acc.merged(b));
+        index.candidates(all).into_iter().any(|u| {
             let other = self.triangles[u as usize];
-            self.triangle_alive[u as usize]
-                && !replaced.contains(&u)
-                && triangles_overlap(tri, &corners, other, &other.map(|v| self.pos[v as usize]))
+            if !self.triangle_alive[u as usize] || replaced.contains(&u) {
+                return false;
+            }
+            let other_corners = other.map(|v| self.pos[v as usize]);
+            let other_box = triangle_box(&other_corners);
+            new.iter()
+                .zip(&corners)
+                .zip(&boxes)
+                .any(|((&tri, c), b)| b.intersects(&other_box) && triangles_overlap(tri, c, other, &other_corners))
         })
     }
 

@@ -16,8 +16,8 @@
 use std::path::{Path, PathBuf};
 
 use amber_mesh::{Mesh3, MeshError, read_mesh};
-use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, StlFaceIds, Surface, SurfaceError, generate_3d};
 use amber_meshgen::ConstantSize;
+use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, StlFaceIds, Surface, SurfaceError, generate_3d};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -172,7 +172,10 @@ mod tests {
 
     /// The shipped data bundle, or `None` (with a message) when it is absent.
     fn shipped_data() -> Option<PathBuf> {
-        let candidates = [Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"), "/work/shared/data/console".into()];
+        let candidates = [
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"),
+            "/work/shared/data/console".into(),
+        ];
         let found = candidates.into_iter().find(|p| p.join("train").is_dir());
         if found.is_none() {
             println!("skipping: the Console data (../shared/data/console) is not present");
