@@ -78,10 +78,7 @@ fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     experiment.test_set = args.test_set;
     experiment.force = args.force;
     experiment.out = args.out;
-    let results = experiment.run()?;
-    print_runs(&results);
-    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
-    Ok(())
+    run_and_report(&experiment)
 }
 
 #[derive(clap::Args, Debug)]
@@ -102,13 +99,12 @@ pub fn ablate(args: AblateArgs) -> anyhow::Result<()> {
     let mut experiment = PoissonExperiment::ablation(args.profile);
     experiment.force = args.force;
     experiment.out = args.out;
-    let results = experiment.run()?;
-    print_runs(&results);
-    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
-    Ok(())
+    run_and_report(&experiment)
 }
 
-fn print_runs(results: &amber_experiments::ExperimentResults) {
+/// Runs the experiment and prints each run's headline numbers.
+fn run_and_report(experiment: &PoissonExperiment) -> anyhow::Result<()> {
+    let results = experiment.run()?;
     for run in &results.runs {
         println!(
             "{} {} seed {}: normalised DCD {:.3} [{:.3}, {:.3}], per step {:?}",
@@ -121,4 +117,6 @@ fn print_runs(results: &amber_experiments::ExperimentResults) {
             run.ndcd_per_step.iter().map(|v| (v * 1000.0).round() / 1000.0).collect::<Vec<_>>()
         );
     }
+    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
+    Ok(())
 }

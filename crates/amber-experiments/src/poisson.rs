@@ -558,28 +558,14 @@ pub fn train_poisson(
     dir: &Path,
     label: &str,
 ) -> anyhow::Result<f64> {
-    let time_path = dir.join("training_time.json");
-    let mut time: TrainingTime = if time_path.exists() { read_json(&time_path)? } else { TrainingTime::default() };
-    if time.finished && dir.join(MODEL_DIR).exists() {
-        let trained: TrainingConfig = read_json(&dir.join(CONFIG_FILE))?;
-        if trained != *config {
-            bail!(
-                "{}: holds a finished run with another configuration; train into a new directory or delete it",
-                dir.display()
-            );
-        }
-        return Ok(time.seconds);
+    if let Some(seconds) = finished_run(dir, config)? {
+        return Ok(seconds);
     }
     let train = load_problems(data_root, manifest, config.data.difficulty, Split::Train, config.seed as usize, config.data.train_problems)?;
     let val = load_problems(data_root, manifest, config.data.difficulty, Split::Val, 0, config.data.val_problems)?;
     let mut training = Training::open(config.clone(), train, dir)?;
     let validation = Evaluation::new(&val, training.limits())?;
-    let mut progress = TimedProgress {
-        inner: TrainingProgress::new(label, training.step(), config.steps),
-        time_path: time_path.clone(),
-        before: time.seconds,
-        started: Instant::now(),
-    };
+    let mut progress = TimedProgress::start(dir, label, training.step(), config.steps)?;
     progress.inner.println(&format!(
         "{} at step {} in {}: h_min {:.3e}, budget {} elements",
         if training.step() > 0 { "resumed" } else { "training" },
@@ -589,11 +575,7 @@ pub fn train_poisson(
         training.limits().max_elements
     ));
     training.run(dir, Some(&validation), &mut progress)?;
-    progress.inner.finish();
-    time.seconds = progress.seconds();
-    time.finished = true;
-    write_json(&time_path, &time)?;
-    Ok(time.seconds)
+    progress.finish()
 }
 
 /// The first `count` problems of a split, generated first where missing (with a progress bar).
@@ -620,25 +602,31 @@ pub fn train_cnn_poisson(
     dir: &Path,
     label: &str,
 ) -> anyhow::Result<f64> {
-    let time_path = dir.join("training_time.json");
-    let mut time: TrainingTime = if time_path.exists() { read_json(&time_path)? } else { TrainingTime::default() };
-    if time.finished && dir.join(MODEL_DIR).exists() {
-        return Ok(time.seconds);
+    if let Some(seconds) = finished_run(dir, config)? {
+        return Ok(seconds);
     }
     let train = load_problems(data_root, manifest, config.data.difficulty, Split::Train, config.seed as usize, config.data.train_problems)?;
     let mut training = CnnTraining::open(config.clone(), train, dir)?;
-    let mut progress = TimedProgress {
-        inner: TrainingProgress::new(label, training.step(), config.steps),
-        time_path: time_path.clone(),
-        before: time.seconds,
-        started: Instant::now(),
-    };
+    let mut progress = TimedProgress::start(dir, label, training.step(), config.steps)?;
     training.run(dir, &mut progress)?;
-    progress.inner.finish();
-    time.seconds = progress.seconds();
-    time.finished = true;
-    write_json(&time_path, &time)?;
-    Ok(time.seconds)
+    progress.finish()
+}
+
+/// Where a run directory records its training wall time.
+const TIME_FILE: &str = "training_time.json";
+
+/// The training time of `dir` if it holds a finished run of `config`; an error if it holds a
+/// finished run of another configuration.
+fn finished_run<C: PartialEq + serde::de::DeserializeOwned>(dir: &Path, config: &C) -> anyhow::Result<Option<f64>> {
+    let time_path = dir.join(TIME_FILE);
+    let time: TrainingTime = if time_path.exists() { read_json(&time_path)? } else { TrainingTime::default() };
+    if !(time.finished && dir.join(MODEL_DIR).exists()) {
+        return Ok(None);
+    }
+    if read_json::<C>(&dir.join(CONFIG_FILE))? != *config {
+        bail!("{}: holds a finished run with another configuration; train into a new directory or delete it", dir.display());
+    }
+    Ok(Some(time.seconds))
 }
 
 /// The progress bar plus a record of the training wall time at every checkpoint, so the time
@@ -651,8 +639,24 @@ struct TimedProgress {
 }
 
 impl TimedProgress {
+    /// Progress of the run in `dir` standing at step `done` of `total`, its clock continuing
+    /// from the time recorded there.
+    fn start(dir: &Path, label: &str, done: u64, total: u64) -> anyhow::Result<Self> {
+        let time_path = dir.join(TIME_FILE);
+        let before = if time_path.exists() { read_json::<TrainingTime>(&time_path)?.seconds } else { 0.0 };
+        Ok(Self { inner: TrainingProgress::new(label, done, total), time_path, before, started: Instant::now() })
+    }
+
     fn seconds(&self) -> f64 {
         self.before + self.started.elapsed().as_secs_f64()
+    }
+
+    /// Records the run as finished; returns its total training time.
+    fn finish(self) -> anyhow::Result<f64> {
+        self.inner.finish();
+        let time = TrainingTime { seconds: self.seconds(), finished: true };
+        write_json(&self.time_path, &time)?;
+        Ok(time.seconds)
     }
 }
 

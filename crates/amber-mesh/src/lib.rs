@@ -20,4 +20,7 @@ pub use error::MeshError;
 pub use io::{MeshData, read_mesh, read_mesh_with_data, write_mesh};
 pub use locate::{Location, PointLocator};
 pub use mesh::{Mesh, Mesh2, Mesh3, centroid, signed_volume, size_from_volume, volume_from_size};
-pub use render::{MISSING_COLOUR, RenderOptions, register_default_font, render_png, render_rgb, viridis, write_png};
+pub use render::{
+    MISSING_COLOUR, RenderOptions, View, register_default_font, render_png, render_rgb, render_surface_png,
+    render_surface_rgb, viridis, write_png,
+};

@@ -1,8 +1,11 @@
-//! PNG pictures of 2D meshes coloured by a per-element scalar, with a colour bar.
+//! PNG pictures of meshes coloured by a per-element scalar, with a colour bar: 2D meshes as
+//! they are, 3D meshes as their shaded boundary surface seen from a viewpoint.
 //!
 //! Triangles are filled straight into an RGB buffer (a pixel takes the colour of the element
 //! containing its centre), edges are drawn as darkened lines, and plotters draws only the text,
-//! with the vendored DejaVu Sans so no system font is needed.
+//! with the vendored DejaVu Sans so no system font is needed. Surfaces are drawn back to front
+//! (painter's algorithm on the front-facing boundary triangles) and their edges are found in a
+//! buffer of which triangle each pixel shows, so hidden edges never show through.
 
 use std::io::Write;
 use std::path::Path;
@@ -13,7 +16,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{FontStyle, TextStyle};
 
 use crate::io::write_atomic;
-use crate::{Mesh2, MeshError};
+use crate::{FacetAdjacency, Mesh2, Mesh3, MeshError, signed_volume};
 
 /// How to draw a mesh picture.
 #[derive(Clone, Debug, PartialEq)]
@@ -122,7 +125,99 @@ pub fn render_rgb(mesh: &Mesh2, values: &[f64], options: &RenderOptions) -> Resu
     if !(MIN_SIZE..=MAX_SIZE).contains(&w) || !(MIN_SIZE..=MAX_SIZE).contains(&h) {
         return Err(format!("image size {w}×{h} is outside {MIN_SIZE}..={MAX_SIZE} pixels per side"));
     }
-    Ok(render(mesh, values, options)?.0)
+    Ok(render(mesh, values, None, options)?.0)
+}
+
+/// Where the camera looks from, for pictures of 3D meshes: `azimuth_deg` around the z axis
+/// from +x, `elevation_deg` above the xy plane. The projection is orthographic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    pub azimuth_deg: f64,
+    pub elevation_deg: f64,
+}
+
+/// The picture of a tetrahedral mesh's boundary surface seen from `view`, each boundary
+/// triangle coloured by its tetrahedron's value and shaded by its angle to the light, as
+/// row-major RGB bytes (see [`render_rgb`]).
+pub fn render_surface_rgb(mesh: &Mesh3, values: &[f64], options: &RenderOptions, view: View) -> Result<Vec<u8>, String> {
+    if values.len() != mesh.num_elements() {
+        return Err(format!("{} rendered values for {} elements", values.len(), mesh.num_elements()));
+    }
+    let (w, h) = (options.width, options.height);
+    if !(MIN_SIZE..=MAX_SIZE).contains(&w) || !(MIN_SIZE..=MAX_SIZE).contains(&h) {
+        return Err(format!("image size {w}×{h} is outside {MIN_SIZE}..={MAX_SIZE} pixels per side"));
+    }
+    let (projected, face_values, shades) = visible_surface(mesh, values, view)?;
+    Ok(render(&projected, &face_values, Some(&shades), options)?.0)
+}
+
+/// Writes [`render_surface_rgb`]'s picture as a PNG file, atomically.
+pub fn render_surface_png(
+    mesh: &Mesh3,
+    values: &[f64],
+    options: &RenderOptions,
+    view: View,
+    path: impl AsRef<Path>,
+) -> Result<(), MeshError> {
+    let path = path.as_ref();
+    let image = render_surface_rgb(mesh, values, options, view)
+        .map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
+    write_png(path, options.width, options.height, &image)
+}
+
+/// The front-facing boundary triangles of `mesh` projected onto the view plane, ordered back
+/// to front, with their tetrahedra's values and their shading factors in (0, 1].
+fn visible_surface(mesh: &Mesh3, values: &[f64], view: View) -> Result<(Mesh2, Vec<f64>, Vec<f64>), String> {
+    let (az, el) = (view.azimuth_deg.to_radians(), view.elevation_deg.to_radians());
+    let eye = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
+    let right = [-az.sin(), az.cos(), 0.0];
+    let up = cross(eye, right);
+    let light = normalised([eye[0] + 0.4 * up[0] + 0.3 * right[0], eye[1] + 0.4 * up[1] + 0.3 * right[1], eye[2] + 0.4 * up[2] + 0.3 * right[2]]);
+    let adjacency = FacetAdjacency::new(mesh).map_err(|e| e.to_string())?;
+    let vertices = mesh.vertices();
+    let mut faces: Vec<(f64, [u32; 3], f64, f64)> = Vec::new();
+    for (element, local) in adjacency.boundary_facets() {
+        let cell = mesh.element(element);
+        let mut tri: Vec<u32> = (0..4).filter(|&k| k != local).map(|k| cell[k]).collect();
+        let [a, b, c] = [0, 1, 2].map(|k| vertices[tri[k] as usize]);
+        let mut normal = cross(sub(b, a), sub(c, a));
+        if dot(normal, sub(vertices[cell[local] as usize], a)) > 0.0 {
+            normal = normal.map(|x| -x);
+            tri.swap(1, 2);
+        }
+        let normal = normalised(normal);
+        if dot(normal, eye) <= 0.0 {
+            continue;
+        }
+        let depth = dot([(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0], eye);
+        let shade = 0.35 + 0.65 * dot(normal, light).max(0.0);
+        faces.push((depth, [tri[0], tri[1], tri[2]], values[element], shade));
+    }
+    faces.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let points: Vec<[f64; 2]> = vertices.iter().map(|&p| [dot(p, right), dot(p, up)]).collect();
+    let extent = points.iter().fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs())).max(f64::MIN_POSITIVE);
+    // Triangles seen edge-on have no area to draw (and are no valid 2D elements).
+    faces.retain(|(_, t, _, _)| signed_volume::<2>(&points, t) > 1e-12 * extent * extent);
+    let cells = faces.iter().flat_map(|f| f.1).collect();
+    let projected = Mesh2::new(points, cells).map_err(|e| e.to_string())?;
+    Ok((projected, faces.iter().map(|f| f.2).collect(), faces.iter().map(|f| f.3).collect()))
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn normalised(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(a, a).sqrt().max(f64::MIN_POSITIVE);
+    a.map(|x| x / n)
 }
 
 /// Writes row-major RGB bytes as a PNG file, atomically.
@@ -324,23 +419,32 @@ impl Canvas {
 
     /// Fills the pixels whose centres lie in the triangle (inclusive, so shared edges leave no gaps).
     fn triangle(&mut self, p: [[f64; 2]; 3], c: [u8; 3]) {
+        for (x, y) in self.covered(p) {
+            self.put(x, y, c);
+        }
+    }
+
+    /// The pixels whose centres lie in the triangle, inside the canvas.
+    fn covered(&self, p: [[f64; 2]; 3]) -> Vec<(i64, i64)> {
         let cross =
             |a: [f64; 2], b: [f64; 2], q: [f64; 2]| (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0]);
         let area = cross(p[0], p[1], p[2]);
         if area == 0.0 || !area.is_finite() {
-            return;
+            return Vec::new();
         }
         let sign = area.signum();
         let lo = |k: usize| (p[0][k].min(p[1][k]).min(p[2][k]) - 0.5).ceil() as i64;
         let hi = |k: usize| (p[0][k].max(p[1][k]).max(p[2][k]) - 0.5).floor() as i64;
+        let mut pixels = Vec::new();
         for y in lo(1).max(0)..=hi(1).min(self.h - 1) {
             for x in lo(0).max(0)..=hi(0).min(self.w - 1) {
                 let q = [x as f64 + 0.5, y as f64 + 0.5];
                 if (0..3).all(|i| sign * cross(p[i], p[(i + 1) % 3], q) >= 0.0) {
-                    self.put(x, y, c);
+                    pixels.push((x, y));
                 }
             }
         }
+        pixels
     }
 
     /// Draws a 1-pixel line whose pixels are the `fill` canvas's colour darkened by `strength`
@@ -368,9 +472,84 @@ fn edge_strength(p: [[f64; 2]; 3]) -> f64 {
     ((thickness - EDGE_FADE.0) / (EDGE_FADE.1 - EDGE_FADE.0)).clamp(0.0, 1.0)
 }
 
+/// Draws every element edge once, as strongly as the thicker of its two elements asks for.
+fn draw_edges(canvas: &mut Canvas, mesh: &Mesh2, pixels: &[[f64; 2]]) {
+    let corners = |cell: &[u32]| [pixels[cell[0] as usize], pixels[cell[1] as usize], pixels[cell[2] as usize]];
+    let mut edges: Vec<((u32, u32), f64)> = Vec::with_capacity(3 * mesh.num_elements());
+    for cell in mesh.elements() {
+        let strength = edge_strength(corners(cell));
+        if strength > 0.0 {
+            for (a, b) in [(cell[0], cell[1]), (cell[1], cell[2]), (cell[2], cell[0])] {
+                edges.push(((a.min(b), a.max(b)), strength));
+            }
+        }
+    }
+    edges.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
+    edges.dedup_by_key(|e| e.0);
+    let fill = Canvas { w: canvas.w, h: canvas.h, rgb: canvas.rgb.clone() };
+    for ((a, b), strength) in edges {
+        canvas.edge(&fill, pixels[a as usize], pixels[b as usize], strength);
+    }
+}
+
+/// Paints shaded surface triangles back to front, remembering which triangle each pixel shows,
+/// then darkens the pixels where the shown triangle changes (visible edges and silhouettes).
+fn draw_surface(
+    canvas: &mut Canvas,
+    mesh: &Mesh2,
+    values: &[f64],
+    shades: &[f64],
+    scale: &Scale,
+    pixels: &[[f64; 2]],
+    edges: bool,
+) {
+    const NONE: u32 = u32::MAX;
+    let corners = |cell: &[u32]| [pixels[cell[0] as usize], pixels[cell[1] as usize], pixels[cell[2] as usize]];
+    let mut shown = vec![NONE; (canvas.w * canvas.h) as usize];
+    let mut strength = Vec::with_capacity(mesh.num_elements());
+    for (k, ((cell, &v), &shade)) in mesh.elements().zip(values).zip(shades).enumerate() {
+        let colour = scale.colour(v).map(|c| (c as f64 * shade).round() as u8);
+        for (x, y) in canvas.covered(corners(cell)) {
+            canvas.put(x, y, colour);
+            shown[(y * canvas.w + x) as usize] = k as u32;
+        }
+        strength.push(edge_strength(corners(cell)));
+    }
+    if !edges {
+        return;
+    }
+    let fill = canvas.rgb.clone();
+    let at = |x: i64, y: i64| shown[(y * canvas.w + x) as usize];
+    for y in 0..canvas.h {
+        for x in 0..canvas.w {
+            let here = at(x, y);
+            let differs = |other: u32| other != here && (here != NONE || other != NONE);
+            let right = if x + 1 < canvas.w { at(x + 1, y) } else { here };
+            let below = if y + 1 < canvas.h { at(x, y + 1) } else { here };
+            let neighbour = [right, below].into_iter().find(|&o| differs(o));
+            if let Some(other) = neighbour {
+                let s = [here, other].iter().filter(|&&t| t != NONE).map(|&t| strength[t as usize]).fold(0.0, f64::max);
+                // Silhouettes are drawn whatever the triangle size.
+                let s = if here == NONE || other == NONE { 1.0 } else { s };
+                let i = 3 * (y * canvas.w + x) as usize;
+                let shade = 1.0 - s * (1.0 - EDGE_SHADE);
+                for k in 0..3 {
+                    canvas.rgb[i + k] = (fill[i + k] as f64 * shade).round() as u8;
+                }
+            }
+        }
+    }
+}
+
 /// Draws the picture into an RGB buffer and says where the mesh went; errors are text-drawing
-/// failures.
-fn render(mesh: &Mesh2, values: &[f64], options: &RenderOptions) -> Result<(Vec<u8>, Layout), String> {
+/// failures. With `shades` (a projected surface, triangles back to front) each colour is
+/// darkened by its triangle's factor and edges are drawn only where they are seen.
+fn render(
+    mesh: &Mesh2,
+    values: &[f64],
+    shades: Option<&[f64]>,
+    options: &RenderOptions,
+) -> Result<(Vec<u8>, Layout), String> {
     register_default_font();
     let (w, h) = (options.width, options.height);
     let scale = Scale::new(values, options);
@@ -394,27 +573,17 @@ fn render(mesh: &Mesh2, values: &[f64], options: &RenderOptions) -> Result<(Vec<
     let layout = Layout::new(mesh, options, label_width);
 
     let pixels: Vec<[f64; 2]> = mesh.vertices().iter().map(|&p| layout.pixel(p)).collect();
-    let corners = |cell: &[u32]| [pixels[cell[0] as usize], pixels[cell[1] as usize], pixels[cell[2] as usize]];
-    for (cell, &v) in mesh.elements().zip(values) {
-        canvas.triangle(corners(cell), scale.colour(v));
-    }
-    if options.edges {
-        // Each edge is drawn once, as strongly as the thicker of its two elements asks for.
-        let mut edges: Vec<((u32, u32), f64)> = Vec::with_capacity(3 * mesh.num_elements());
-        for cell in mesh.elements() {
-            let strength = edge_strength(corners(cell));
-            if strength > 0.0 {
-                for (a, b) in [(cell[0], cell[1]), (cell[1], cell[2]), (cell[2], cell[0])] {
-                    edges.push(((a.min(b), a.max(b)), strength));
-                }
+    match shades {
+        None => {
+            for (cell, &v) in mesh.elements().zip(values) {
+                let corners = [pixels[cell[0] as usize], pixels[cell[1] as usize], pixels[cell[2] as usize]];
+                canvas.triangle(corners, scale.colour(v));
+            }
+            if options.edges {
+                draw_edges(&mut canvas, mesh, &pixels);
             }
         }
-        edges.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
-        edges.dedup_by_key(|e| e.0);
-        let fill = Canvas { w: canvas.w, h: canvas.h, rgb: canvas.rgb.clone() };
-        for ((a, b), strength) in edges {
-            canvas.edge(&fill, pixels[a as usize], pixels[b as usize], strength);
-        }
+        Some(shades) => draw_surface(&mut canvas, mesh, values, shades, &scale, &pixels, options.edges),
     }
 
     // Colour bar: a gradient from the bottom (low) to the top (high), framed, with ticks.
@@ -479,7 +648,7 @@ mod tests {
         render_png(&mesh, &values, &options, &path).unwrap();
         let (w, h, rgb) = decode(&path);
         assert_eq!((w, h), (400, 300));
-        let (_, layout) = render(&mesh, &values, &options).unwrap();
+        let (_, layout) = render(&mesh, &values, None, &options).unwrap();
         for (e, expected) in [viridis(0.0), viridis(0.5), viridis(1.0), MISSING_COLOUR].into_iter().enumerate() {
             let [x, y] = layout.pixel(mesh.midpoint(e));
             let i = 3 * (y as usize * w as usize + x as usize);
@@ -489,6 +658,61 @@ mod tests {
         let [x0, y0] = layout.pixel([0.0, 0.0]);
         let [x1, y1] = layout.pixel([2.0, 1.0]);
         assert!(((x1 - x0) / (y0 - y1) - 2.0).abs() < 1e-12);
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    /// Two unit cubes of 6 tetrahedra each, at x ∈ [0, 1] (value 1) and x ∈ [3, 4] (value 2).
+    fn two_cubes() -> (Mesh3, Vec<f64>) {
+        let mut vertices = Vec::new();
+        let mut cells = Vec::new();
+        let mut values = Vec::new();
+        for (offset, value) in [(0.0, 1.0), (3.0, 2.0)] {
+            let base = vertices.len() as u32;
+            for k in 0..8 {
+                vertices.push([offset + (k & 1) as f64, ((k >> 1) & 1) as f64, ((k >> 2) & 1) as f64]);
+            }
+            // Kuhn's triangulation along the diagonal 0 → 7.
+            for path in [[1, 3], [1, 5], [2, 3], [2, 6], [4, 5], [4, 6]] {
+                cells.extend([base, base + path[0], base + path[1], base + 7]);
+                values.push(value);
+            }
+        }
+        (Mesh3::new_reoriented(vertices, cells).unwrap(), values)
+    }
+
+    #[test]
+    fn surfaces_show_the_nearest_front_faces_shaded() {
+        let (mesh, values) = two_cubes();
+        let options = RenderOptions { width: 300, height: 200, edges: false, ..Default::default() };
+        let pixel = |view: View| {
+            let rgb = render_surface_rgb(&mesh, &values, &options, view).unwrap();
+            // The cubes' square outline is centred vertically; sample a pixel inside it.
+            let (_, layout) = {
+                let (projected, v, s) = visible_surface(&mesh, &values, view).unwrap();
+                render(&projected, &v, Some(&s), &options).unwrap()
+            };
+            let [x, y] = layout.pixel([0.5 * if view.azimuth_deg == 0.0 { 1.0 } else { -1.0 }, 0.5]);
+            let i = 3 * (y as usize * 300 + x as usize);
+            [rgb[i], rgb[i + 1], rgb[i + 2]]
+        };
+        // Face-on, the face normal is the eye direction: shade 0.35 + 0.65 · cos(light, eye).
+        let shade = 0.35 + 0.65 / (1.0f64 + 0.16 + 0.09).sqrt();
+        let expected = |t: f64| viridis(t).map(|c| (c as f64 * shade).round() as u8);
+        // From +x the cube at x ∈ [3, 4] hides the other; from −x it is the other way round.
+        assert_eq!(pixel(View { azimuth_deg: 0.0, elevation_deg: 0.0 }), expected(1.0));
+        assert_eq!(pixel(View { azimuth_deg: 180.0, elevation_deg: 0.0 }), expected(0.0));
+    }
+
+    #[test]
+    fn surface_pictures_are_written_and_bad_requests_are_errors() {
+        let (mesh, values) = two_cubes();
+        let dir = std::env::temp_dir().join(format!("amber-surface-{}", std::process::id()));
+        let path = dir.join("cubes.png");
+        std::fs::create_dir_all(&dir).unwrap();
+        let view = View { azimuth_deg: 30.0, elevation_deg: 25.0 };
+        render_surface_png(&mesh, &values, &RenderOptions::default(), view, &path).unwrap();
+        assert_eq!(decode(&path).0, 1000);
+        assert!(render_surface_rgb(&mesh, &values[1..], &RenderOptions::default(), view).is_err());
         std::fs::remove_dir_all(dir).unwrap();
     }
 
