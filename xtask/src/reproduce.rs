@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-use amber_experiments::{Method, MethodSpec, PoissonExperiment, read_json};
+use amber_experiments::{ConsoleExperiment, ExperimentResults, Method, MethodSpec, PoissonExperiment, read_json};
+use amber_tasks::console::TrainSet;
 use amber_tasks::poisson::Difficulty;
 use amber_train::Profile;
 
@@ -18,6 +19,30 @@ pub struct Args {
 enum Experiment {
     /// Poisson on random L-shapes (spec §1): AMBER-Mean and AMBER-Max per difficulty.
     Poisson(PoissonArgs),
+    /// The Console car-seat parts (spec §9): AMBER-Mean, AMBER-Max, CNN 32³ and 64³.
+    Console(ConsoleArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct ConsoleArgs {
+    /// smoke (CI: minutes), quick (default), paper (GPU scale).
+    #[arg(long, default_value = "quick")]
+    profile: Profile,
+    /// The Console data: `train/ val/ [test/]` with NNN.nas, and `reference_surface/<split>/NNN.stl`.
+    #[arg(long, default_value = "../shared/data/console")]
+    data: PathBuf,
+    /// Train on all 19 training parts instead of the paper's 15.
+    #[arg(long)]
+    all_train: bool,
+    /// Methods, comma-separated (default: the profile's).
+    #[arg(long, value_delimiter = ',')]
+    methods: Vec<Method>,
+    /// Retrain and re-evaluate even when cached.
+    #[arg(long)]
+    force: bool,
+    /// Output directory.
+    #[arg(long, default_value = "results/console")]
+    out: PathBuf,
 }
 
 #[derive(clap::Args, Debug)]
@@ -55,7 +80,24 @@ struct PoissonArgs {
 pub fn run(args: Args) -> anyhow::Result<()> {
     match args.experiment {
         Experiment::Poisson(args) => poisson(args),
+        Experiment::Console(args) => console(args),
     }
+}
+
+fn console(args: ConsoleArgs) -> anyhow::Result<()> {
+    let mut experiment = ConsoleExperiment::new(args.profile, &args.data);
+    if args.all_train {
+        experiment.train_set = TrainSet::All;
+    }
+    if !args.methods.is_empty() {
+        experiment.methods = args.methods.into_iter().map(MethodSpec::plain).collect();
+    }
+    experiment.force = args.force;
+    experiment.out = args.out;
+    let results = experiment.run()?;
+    print_runs(&results);
+    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
+    Ok(())
 }
 
 fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
@@ -105,6 +147,13 @@ pub fn ablate(args: AblateArgs) -> anyhow::Result<()> {
 /// Runs the experiment and prints each run's headline numbers.
 fn run_and_report(experiment: &PoissonExperiment) -> anyhow::Result<()> {
     let results = experiment.run()?;
+    print_runs(&results);
+    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
+    Ok(())
+}
+
+/// Prints each run's headline numbers.
+fn print_runs(results: &ExperimentResults) {
     for run in &results.runs {
         println!(
             "{} {} seed {}: normalised DCD {:.3} [{:.3}, {:.3}], per step {:?}",
@@ -116,7 +165,9 @@ fn run_and_report(experiment: &PoissonExperiment) -> anyhow::Result<()> {
             run.ndcd_quantiles[1],
             run.ndcd_per_step.iter().map(|v| (v * 1000.0).round() / 1000.0).collect::<Vec<_>>()
         );
+        println!(
+            "  raw DCD d(Mᵀ) {:.4}, d(M⁰) {:.4}, d(M̂) {:.4}; {:.0} elements (expert {:.0}); {} failed steps",
+            run.dcd, run.dcd_initial, run.dcd_reconstruction, run.elements, run.expert_elements, run.failed_steps
+        );
     }
-    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
-    Ok(())
 }

@@ -6,17 +6,22 @@
 //! in one schema ([`ExperimentResults`]), `table.md` with the paper's numbers beside ours, and
 //! PNG charts and mesh galleries. Progress goes to the terminal as bars and lines.
 
+mod console;
 mod method;
+mod outputs;
 mod plots;
 mod poisson;
 mod progress;
 mod report;
 mod results;
+mod run;
 mod table;
 
+pub use console::ConsoleExperiment;
 pub use method::{Method, MethodSpec, Variant};
-pub use plots::{Bar, Series, Tile, bar_chart, line_chart, mesh_gallery};
-pub use poisson::{PoissonExperiment, RunConfig, train_cnn_poisson, train_poisson};
+pub use plots::{Bar, Series, Tile, TileMesh, bar_chart, line_chart, mesh_gallery};
+pub use poisson::{PoissonExperiment, train_poisson};
+pub use run::{RunConfig, train_amber, train_cnn};
 pub use progress::{TrainingProgress, item_bar};
 pub use report::{commit, config_hash, machine, merge_json, read_json, write_atomic, write_json};
 pub use results::{ExperimentResults, ProblemEvaluation, RunKey, RunResult, StepEvaluation};

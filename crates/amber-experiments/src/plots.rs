@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use amber_mesh::{Mesh2, RenderOptions, register_default_font, render_rgb, write_png};
+use amber_mesh::{Mesh2, Mesh3, RenderOptions, View, register_default_font, render_rgb, render_surface_rgb, write_png};
 use anyhow::{Context, anyhow};
 use plotters::coord::ranged1d::SegmentValue;
 use plotters::prelude::*;
@@ -171,8 +171,14 @@ pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series
 /// One picture of a gallery: a mesh coloured by per-element values.
 pub struct Tile<'m> {
     pub title: String,
-    pub mesh: &'m Mesh2,
+    pub mesh: TileMesh<'m>,
     pub values: Vec<f64>,
+}
+
+/// The mesh of a tile: drawn flat (2D), or as its boundary surface from a viewpoint (3D).
+pub enum TileMesh<'m> {
+    Flat(&'m Mesh2),
+    Solid(&'m Mesh3, View),
 }
 
 /// A grid of mesh pictures (rows of tiles), every tile on the same logarithmic colour range so
@@ -193,7 +199,11 @@ pub fn mesh_gallery(path: &Path, rows: &[Vec<Tile<'_>>], tile: (u32, u32)) -> an
                 range: Some(range),
                 edges: true,
             };
-            let image = render_rgb(t.mesh, &t.values, &options).map_err(|e| anyhow!("{}: {e}", t.title))?;
+            let image = match t.mesh {
+                TileMesh::Flat(mesh) => render_rgb(mesh, &t.values, &options),
+                TileMesh::Solid(mesh, view) => render_surface_rgb(mesh, &t.values, &options, view),
+            }
+            .map_err(|e| anyhow!("{}: {e}", t.title))?;
             for y in 0..tile.1 as usize {
                 let src = &image[3 * y * tile.0 as usize..3 * (y + 1) * tile.0 as usize];
                 let dst_row = r * tile.1 as usize + y;
@@ -233,7 +243,7 @@ mod tests {
         line_chart(&path, "per step", "step", "normalised DCD", &[series]).unwrap();
         assert_eq!(decode(&path), (WIDTH, HEIGHT));
         let mesh = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]], vec![0, 1, 2, 1, 3, 2]).unwrap();
-        let tile = |title: &str| Tile { title: title.into(), mesh: &mesh, values: mesh.sizes() };
+        let tile = |title: &str| Tile { title: title.into(), mesh: TileMesh::Flat(&mesh), values: mesh.sizes() };
         let path = dir.path().join("gallery.png");
         mesh_gallery(&path, &[vec![tile("a"), tile("b"), tile("c")], vec![tile("d")]], (200, 150)).unwrap();
         assert_eq!(decode(&path), (600, 300));

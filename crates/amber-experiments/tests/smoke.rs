@@ -123,3 +123,42 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     assert!(table.contains("| amber-max (no-softplus) |"), "{table}");
     assert!(experiment.out.join("ndcd_bars.png").exists());
 }
+
+/// The shipped Console data, or `None` (with a message) when it is absent.
+fn console_data() -> Option<std::path::PathBuf> {
+    let candidates =
+        [Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"), "/work/shared/data/console".into()];
+    let found = candidates.into_iter().find(|p| p.join("train").is_dir());
+    if found.is_none() {
+        println!("skipping: the Console data (../shared/data/console) is not present");
+    }
+    found
+}
+
+#[test]
+fn console_smoke_trains_evaluates_on_val_and_draws_surfaces() {
+    let Some(data) = console_data() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let mut experiment = amber_experiments::ConsoleExperiment::new(Profile::Smoke, &data);
+    experiment.runs_root = dir.path().join("data/runs");
+    experiment.out = dir.path().join("results/console");
+    // Few steps: this checks the 3D plumbing end to end, not the quality.
+    experiment.overrides = serde_json::json!({ "steps": 16, "checkpoint_interval": 8, "validation_interval": 0 });
+    let results = experiment.run().unwrap();
+    assert_eq!(results.experiment, "console");
+    assert_eq!(results.config["test_split"], "val");
+    let methods: Vec<&str> = results.runs.iter().map(|r| r.method.as_str()).collect();
+    assert_eq!(methods, ["amber-mean", "amber-max"]);
+    for run in &results.runs {
+        assert_eq!(run.test_problems, 2, "val/001 and val/002");
+        assert_eq!(run.ndcd_per_step.len(), amber_train::TrainingConfig::smoke().inference_steps);
+        // The raw anchors of the normalisation are the spec's (d(M⁰) ≈ 0.75–0.85, d(M̂) ≈ 0.46–0.52).
+        assert!((0.6..0.95).contains(&run.dcd_initial) && (0.35..0.6).contains(&run.dcd_reconstruction), "{run:?}");
+        assert!(run.ndcd.is_finite());
+    }
+    for file in ["results.json", "table.md", "ndcd_bars.png", "ndcd_per_step_console.png", "gallery_console_view1.png", "gallery_console_view2.png"] {
+        assert!(experiment.out.join(file).exists(), "{file} missing");
+    }
+    // Two methods × two parts; steps 1, 2, T and the expert.
+    assert_eq!(png_size(&experiment.out.join("gallery_console_view1.png")), (4 * 460, 4 * 380));
+}

@@ -1,0 +1,198 @@
+//! The Console experiment (spec §9, §10): AMBER-Mean, AMBER-Max and the 3D CNNs trained on the
+//! real car-seat parts, evaluated on `test/` when the data has it, else on `val/`; the same
+//! outputs as the Poisson experiment, with galleries of the meshes' surfaces from two
+//! viewpoints and the final meshes as `.vtu` for ParaView.
+
+use std::path::{Path, PathBuf};
+
+use amber_mesh::{Mesh3, View};
+use amber_tasks::console::{ConsoleProblem, ConsoleSplit, TrainSet, has_test_split, part_names};
+use amber_train::{CnnConfig, Profile, TrainingConfig};
+use anyhow::{Context, bail};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::method::{Method, MethodSpec};
+use crate::outputs::{Setting, gallery_rows, write_outputs};
+use crate::plots::{Tile, TileMesh, mesh_gallery};
+use crate::report::{commit, machine, merge_json};
+use crate::results::{ExperimentResults, RunKey, RunResult};
+use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, train_amber, train_cnn};
+
+/// The two viewpoints of the galleries.
+const VIEWS: [View; 2] =
+    [View { azimuth_deg: 35.0, elevation_deg: 30.0 }, View { azimuth_deg: 215.0, elevation_deg: -20.0 }];
+
+/// Everything an invocation of the Console experiment decides.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConsoleExperiment {
+    pub profile: Profile,
+    /// The Console data directory (`train/ val/ [test/] reference_surface/`).
+    pub data: PathBuf,
+    /// The paper's 15 training parts, or all.
+    pub train_set: TrainSet,
+    /// Training seeds 0..seeds.
+    pub seeds: usize,
+    pub methods: Vec<MethodSpec>,
+    /// Root of the cached training runs.
+    pub runs_root: PathBuf,
+    /// Where results.json, table.md and the pictures go.
+    pub out: PathBuf,
+    /// Fields merged into every AMBER run's training config.
+    pub overrides: serde_json::Value,
+    /// Fields merged into every CNN run's config.
+    pub cnn_overrides: serde_json::Value,
+    /// Retrain and re-evaluate even when cached.
+    pub force: bool,
+}
+
+impl ConsoleExperiment {
+    /// The defaults of a profile on the data in `data`: AMBER-Mean, AMBER-Max, CNN 32³ and 64³
+    /// (smoke: AMBER only), one seed (paper: 4).
+    pub fn new(profile: Profile, data: &Path) -> Self {
+        let mut methods: Vec<MethodSpec> = Method::DEFAULT.into_iter().map(MethodSpec::plain).collect();
+        if profile != Profile::Smoke {
+            methods.extend([32, 64].map(|resolution| MethodSpec::plain(Method::Cnn { resolution })));
+        }
+        Self {
+            profile,
+            data: data.to_owned(),
+            train_set: TrainSet::Paper,
+            seeds: if profile == Profile::Paper { 4 } else { 1 },
+            methods,
+            runs_root: PathBuf::from("data/runs"),
+            out: PathBuf::from("results/console"),
+            overrides: serde_json::json!({}),
+            cnn_overrides: serde_json::json!({}),
+            force: false,
+        }
+    }
+
+    /// The configuration of one run: the profile's, with the Console task's settings (spec §9:
+    /// latent width 128, h_min at the 0.5 % quantile of the training experts' sizes), the
+    /// method's labels, the overrides and the seed.
+    pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<RunConfig> {
+        let patch = |value: &mut serde_json::Value, overrides: &serde_json::Value| {
+            merge_json(value, overrides);
+            merge_json(value, &spec.variant.overrides);
+        };
+        Ok(match spec.method {
+            Method::AmberMean | Method::AmberMax => {
+                let mut config = TrainingConfig::profile(self.profile);
+                if self.profile != Profile::Smoke {
+                    config.network.latent_dim = 128;
+                }
+                config.min_size_quantile = 0.005;
+                config.aggregation = spec.method.aggregation();
+                config.seed = seed as u64;
+                let mut value = serde_json::to_value(&config)?;
+                patch(&mut value, &self.overrides);
+                let config: TrainingConfig = serde_json::from_value(value)
+                    .with_context(|| format!("the overrides of {} do not fit its configuration", spec.label()))?;
+                config.validate()?;
+                RunConfig::Amber(config)
+            }
+            Method::Cnn { resolution } => {
+                let mut config = CnnConfig::profile(self.profile);
+                config.resolution = resolution;
+                config.min_size_quantile = 0.005;
+                config.aggregation = spec.method.aggregation();
+                config.seed = seed as u64;
+                let mut value = serde_json::to_value(&config)?;
+                patch(&mut value, &self.cnn_overrides);
+                let config: CnnConfig = serde_json::from_value(value)
+                    .with_context(|| format!("the overrides of {} do not fit its configuration", spec.label()))?;
+                config.validate()?;
+                RunConfig::Cnn(config)
+            }
+        })
+    }
+
+    /// Runs the experiment and writes its outputs under `out`.
+    pub fn run(&self) -> anyhow::Result<ExperimentResults> {
+        if self.methods.is_empty() || self.seeds == 0 {
+            bail!("nothing to run: give at least one method and seed");
+        }
+        let test_split = if has_test_split(&self.data) { ConsoleSplit::Test } else { ConsoleSplit::Val };
+        let test = self.load(test_split, usize::MAX)?;
+        let test_name = format!("console {} ({} parts)", test_split.name(), test.len());
+        let mut runs = Vec::new();
+        let mut configs = Vec::new();
+        let mut rows: Vec<(String, Vec<Vec<Mesh3>>)> = Vec::new();
+        for seed in 0..self.seeds {
+            for spec in &self.methods {
+                let config = self.run_config(spec, seed)?;
+                let data_key = ("data", serde_json::json!({ "dir": self.data, "train_set": self.train_set }));
+                let run =
+                    Run::new(&self.runs_root, "console", "console", spec, &config, data_key, &test_name, self.force)?;
+                let evaluated = run.train_and_evaluate(&config, &test, |dir, label| match &config {
+                    RunConfig::Amber(c) => {
+                        let problems = || {
+                            Ok((self.load(ConsoleSplit::Train, c.data.train_problems)?, self.load(ConsoleSplit::Val, c.data.val_problems)?))
+                        };
+                        train_amber(c, problems, dir, label)
+                    }
+                    RunConfig::Cnn(c) => train_cnn(c, || self.load(ConsoleSplit::Train, c.data.train_problems), dir, label),
+                })?;
+                configs.push(serde_json::json!({
+                    "method": spec.method, "variant": spec.variant.name, "seed": seed, "run_dir": run.dir,
+                    "training": config.to_json()?,
+                }));
+                runs.push(RunResult::new(
+                    RunKey {
+                        method: &spec.method.name(),
+                        variant: &spec.variant.name,
+                        difficulty: "console",
+                        seed,
+                        train_seconds: evaluated.train_seconds,
+                        eval_seconds: evaluated.eval_seconds,
+                    },
+                    &evaluated.problems,
+                ));
+                if seed == 0 && spec.variant.name == "default" {
+                    rows.push((spec.label(), run.gallery_meshes(config.inference_steps())?));
+                }
+            }
+        }
+        let results = ExperimentResults {
+            experiment: "console".into(),
+            profile: self.profile.name().into(),
+            commit: commit(),
+            machine: machine(),
+            config: serde_json::json!({ "experiment": self, "test_split": test_split.name(), "runs": configs }),
+            runs,
+        };
+        let setting = Setting { name: "console".into(), caption: format!("Console ({} parts)", test_split.name()) };
+        write_outputs(&self.out, &results, &[setting], &self.methods, &paper_number)?;
+        let experts: Vec<&Mesh3> = test.iter().take(GALLERY_PROBLEMS).map(|p| &p.expert_mesh).collect();
+        for (k, view) in VIEWS.into_iter().enumerate() {
+            let tiles = gallery_rows(&rows, &experts, solid_tile(view), Mesh3::num_elements);
+            mesh_gallery(&self.out.join(format!("gallery_console_view{}.png", k + 1)), &tiles, (460, 380))?;
+        }
+        Ok(results)
+    }
+
+    /// The first `count` parts of a split (all of them for `usize::MAX`), loaded in parallel
+    /// (their initial meshes are generated on loading).
+    fn load(&self, split: ConsoleSplit, count: usize) -> anyhow::Result<Vec<ConsoleProblem>> {
+        let mut names = part_names(&self.data, split, self.train_set)?;
+        names.truncate(count);
+        Ok(names.par_iter().map(|stem| ConsoleProblem::load(&self.data, split, stem)).collect::<Result<_, _>>()?)
+    }
+}
+
+/// A gallery tile of a mesh's surface from `view`, coloured by element size.
+fn solid_tile(view: View) -> impl for<'m> Fn(String, &'m Mesh3) -> Tile<'m> {
+    move |title, mesh| Tile { title, mesh: TileMesh::Solid(mesh, view), values: mesh.sizes() }
+}
+
+/// The paper's normalised DCD on the Console test split (spec §10, mean of 4 seeds).
+fn paper_number(row: &str, _setting: &str) -> Option<f64> {
+    match row {
+        "amber-mean" => Some(0.196),
+        "amber-max" => Some(0.238),
+        "cnn-32" => Some(0.418),
+        "cnn-64" => Some(0.309),
+        _ => None,
+    }
+}

@@ -1,0 +1,326 @@
+//! One trained and evaluated configuration, for any task: its directory (named by a hash of
+//! everything that determines it), training that resumes and is never repeated once finished,
+//! evaluation on test problems cached beside it, and the test meshes kept for galleries.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use amber_mesh::{Mesh, MeshData, read_mesh, write_mesh};
+use amber_train::{
+    AmberModel, CONFIG_FILE, CnnConfig, CnnModel, CnnObserver, CnnStepReport, CnnTraining, Evaluation,
+    EvaluationSummary, MODEL_DIR, Problem, Rollout, StepReport, Training, TrainingConfig, TrainingObserver,
+};
+use anyhow::{Context, bail};
+use serde::{Deserialize, Serialize};
+
+use crate::method::MethodSpec;
+use crate::progress::TrainingProgress;
+use crate::report::{config_hash, read_json, write_json};
+use crate::results::ProblemEvaluation;
+
+/// Test problems whose rollouts are kept as meshes (`.vtu`) and drawn in the gallery.
+pub(crate) const GALLERY_PROBLEMS: usize = 2;
+
+/// Where a run directory records its training wall time.
+const TIME_FILE: &str = "training_time.json";
+
+/// The configuration of one run of either kind of method.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunConfig {
+    Amber(TrainingConfig),
+    Cnn(CnnConfig),
+}
+
+impl RunConfig {
+    /// Generation steps of the method's rollouts (the CNN predicts once).
+    pub fn inference_steps(&self) -> usize {
+        match self {
+            RunConfig::Amber(c) => c.inference_steps,
+            RunConfig::Cnn(_) => 1,
+        }
+    }
+
+    pub fn seed(&self) -> u64 {
+        match self {
+            RunConfig::Amber(c) => c.seed,
+            RunConfig::Cnn(c) => c.seed,
+        }
+    }
+
+    /// The config as JSON, tagged with its kind.
+    pub fn to_json(&self) -> anyhow::Result<serde_json::Value> {
+        Ok(match self {
+            RunConfig::Amber(c) => serde_json::json!({ "amber": c }),
+            RunConfig::Cnn(c) => serde_json::json!({ "cnn": c }),
+        })
+    }
+
+    /// The config as JSON, untagged (what the run directory's hash covers).
+    fn untagged(&self) -> anyhow::Result<serde_json::Value> {
+        Ok(match self {
+            RunConfig::Amber(c) => serde_json::to_value(c)?,
+            RunConfig::Cnn(c) => serde_json::to_value(c)?,
+        })
+    }
+}
+
+/// A run's evaluation on a test set, as cached in its directory.
+#[derive(Serialize, Deserialize)]
+pub(crate) struct CachedEvaluation {
+    pub test_set: String,
+    pub train_seconds: f64,
+    pub eval_seconds: f64,
+    pub problems: Vec<ProblemEvaluation>,
+}
+
+/// A run directory: `<runs>/<task>/<setting>/<method>[-<variant>]/seed<r>-<hash>`, where the
+/// hash covers the config and `data_key` (what identifies the training data).
+pub(crate) struct Run {
+    pub dir: PathBuf,
+    pub label: String,
+    test_name: String,
+    eval_dir: PathBuf,
+}
+
+impl Run {
+    pub fn new(
+        runs_root: &Path,
+        task: &str,
+        setting: &str,
+        spec: &MethodSpec,
+        config: &RunConfig,
+        data_key: (&str, serde_json::Value),
+        test_name: &str,
+        force: bool,
+    ) -> anyhow::Result<Self> {
+        let name = match spec.variant.name.as_str() {
+            "default" => spec.method.name(),
+            variant => format!("{}-{variant}", spec.method.name()),
+        };
+        let mut key = serde_json::json!({ "config": config.untagged()? });
+        key[data_key.0] = data_key.1;
+        let dir = runs_root
+            .join(task)
+            .join(setting)
+            .join(&name)
+            .join(format!("seed{}-{}", config.seed(), config_hash(&key)));
+        if force && dir.exists() {
+            std::fs::remove_dir_all(&dir).with_context(|| format!("{}: cannot remove for --force", dir.display()))?;
+        }
+        let eval_dir = dir.join(format!("eval-{}", config_hash(&serde_json::json!(test_name))));
+        let label = format!("{} {setting} seed {}", spec.label(), config.seed());
+        Ok(Self { dir, label, test_name: test_name.into(), eval_dir })
+    }
+
+    /// Trains the run with `train` (which must resume or reuse what `dir` holds; it returns the
+    /// training time), then evaluates the model on `test`; a cached evaluation skips both.
+    pub fn train_and_evaluate<const D: usize, P: Problem<D>>(
+        &self,
+        config: &RunConfig,
+        test: &[P],
+        train: impl FnOnce(&Path, &str) -> anyhow::Result<f64>,
+    ) -> anyhow::Result<CachedEvaluation> {
+        let cache = self.eval_dir.join("evaluation.json");
+        if cache.exists() {
+            let cached: CachedEvaluation = read_json(&cache)?;
+            println!("{}: reusing the evaluation in {}", self.label, cache.display());
+            return Ok(cached);
+        }
+        let train_seconds = train(&self.dir, &self.label)?;
+        let started = Instant::now();
+        let rollouts = match config {
+            RunConfig::Amber(config) => {
+                let model = AmberModel::load(&self.dir.join(MODEL_DIR))?;
+                let evaluation = Evaluation::new(test, &model.predictor.limits)?;
+                evaluation.run(&model.network, &model.predictor, config.inference_steps)?.0
+            }
+            RunConfig::Cnn(_) => {
+                let model = CnnModel::load(&self.dir.join(MODEL_DIR))?;
+                let references = Evaluation::new(test, &model.predictor.limits)?.references;
+                model.rollouts(test, &references)?
+            }
+        };
+        let eval_seconds = started.elapsed().as_secs_f64();
+        let problems: Vec<ProblemEvaluation> = rollouts
+            .iter()
+            .zip(test)
+            .map(|(r, p)| ProblemEvaluation::of(r, p.expert_mesh().num_elements()))
+            .collect();
+        self.save_gallery_meshes(&rollouts)?;
+        let summary = EvaluationSummary::new(test, &rollouts);
+        println!(
+            "{}: test normalised DCD {:.3} after {} steps ({} problems, {:.0} s)",
+            self.label,
+            summary.final_normalised_dcd().unwrap_or(f64::NAN),
+            config.inference_steps(),
+            test.len(),
+            eval_seconds
+        );
+        let evaluated = CachedEvaluation { test_set: self.test_name.clone(), train_seconds, eval_seconds, problems };
+        write_json(&cache, &evaluated)?;
+        Ok(evaluated)
+    }
+
+    fn gallery_path(&self, problem: usize, step: usize) -> PathBuf {
+        self.eval_dir.join(format!("problem{problem:03}-step{}.vtu", step + 1))
+    }
+
+    /// Keeps every step's mesh of the first test problems as `.vtu` (ParaView) for the gallery.
+    fn save_gallery_meshes<const D: usize>(&self, rollouts: &[Rollout<D>]) -> anyhow::Result<()> {
+        std::fs::create_dir_all(&self.eval_dir)
+            .with_context(|| format!("{}: cannot create directory", self.eval_dir.display()))?;
+        for (k, rollout) in rollouts.iter().take(GALLERY_PROBLEMS).enumerate() {
+            for (t, step) in rollout.steps.iter().enumerate() {
+                let mut data = MeshData::default();
+                data.cell.insert("size".into(), step.mesh.sizes());
+                write_mesh(&step.mesh, self.gallery_path(k, t), &data)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The saved gallery meshes, per problem, every step.
+    pub fn gallery_meshes<const D: usize>(&self, steps: usize) -> anyhow::Result<Vec<Vec<Mesh<D>>>> {
+        let mut meshes = Vec::new();
+        for k in 0..GALLERY_PROBLEMS {
+            let paths: Vec<PathBuf> = (0..steps).map(|t| self.gallery_path(k, t)).collect();
+            if !paths.iter().all(|p| p.exists()) {
+                break;
+            }
+            meshes.push(paths.iter().map(read_mesh).collect::<Result<_, _>>()?);
+        }
+        Ok(meshes)
+    }
+}
+
+/// Trains AMBER into `dir` until the config's last step: resumes from the newest checkpoint in
+/// `dir`, validates on the validation problems as configured, writes the model to `dir/model`.
+/// A finished run of the same config is not retrained (and `problems` is not called). Returns
+/// the training wall time, summed over resumed sessions; `label` names the run in progress
+/// lines. `problems` gives the training and validation problems.
+pub fn train_amber<const D: usize, P: Problem<D>>(
+    config: &TrainingConfig,
+    problems: impl FnOnce() -> anyhow::Result<(Vec<P>, Vec<P>)>,
+    dir: &Path,
+    label: &str,
+) -> anyhow::Result<f64> {
+    if let Some(seconds) = finished_run(dir, config)? {
+        return Ok(seconds);
+    }
+    let (train, val) = problems()?;
+    let mut training = Training::open(config.clone(), train, dir)?;
+    let validation = Evaluation::new(&val, training.limits())?;
+    let mut progress = TimedProgress::start(dir, label, training.step(), config.steps)?;
+    progress.inner.println(&format!(
+        "{} at step {} in {}: h_min {:.3e}, budget {} elements",
+        if training.step() > 0 { "resumed" } else { "training" },
+        training.step(),
+        dir.display(),
+        training.limits().min_size,
+        training.limits().max_elements
+    ));
+    training.run(dir, Some(&validation), &mut progress)?;
+    progress.finish()
+}
+
+/// Trains the U-Net baseline into `dir` (as [`train_amber`] does AMBER): resumable, not
+/// retrained once finished; returns the training wall time.
+pub fn train_cnn<const D: usize, P: Problem<D>>(
+    config: &CnnConfig,
+    problems: impl FnOnce() -> anyhow::Result<Vec<P>>,
+    dir: &Path,
+    label: &str,
+) -> anyhow::Result<f64> {
+    if let Some(seconds) = finished_run(dir, config)? {
+        return Ok(seconds);
+    }
+    let mut training = CnnTraining::open(config.clone(), problems()?, dir)?;
+    let mut progress = TimedProgress::start(dir, label, training.step(), config.steps)?;
+    training.run(dir, &mut progress)?;
+    progress.finish()
+}
+
+/// Training wall time, accumulated over resumed sessions.
+#[derive(Default, Serialize, Deserialize)]
+struct TrainingTime {
+    seconds: f64,
+    finished: bool,
+}
+
+/// The training time of `dir` if it holds a finished run of `config`; an error if it holds a
+/// finished run of another configuration.
+fn finished_run<C: PartialEq + serde::de::DeserializeOwned>(dir: &Path, config: &C) -> anyhow::Result<Option<f64>> {
+    let time_path = dir.join(TIME_FILE);
+    let time: TrainingTime = if time_path.exists() { read_json(&time_path)? } else { TrainingTime::default() };
+    if !(time.finished && dir.join(MODEL_DIR).exists()) {
+        return Ok(None);
+    }
+    if read_json::<C>(&dir.join(CONFIG_FILE))? != *config {
+        bail!("{}: holds a finished run with another configuration; train into a new directory or delete it", dir.display());
+    }
+    Ok(Some(time.seconds))
+}
+
+/// The progress bar plus a record of the training wall time at every checkpoint, so the time
+/// of a resumed run counts its earlier sessions.
+struct TimedProgress {
+    inner: TrainingProgress,
+    time_path: PathBuf,
+    before: f64,
+    started: Instant,
+}
+
+impl TimedProgress {
+    /// Progress of the run in `dir` standing at step `done` of `total`, its clock continuing
+    /// from the time recorded there.
+    fn start(dir: &Path, label: &str, done: u64, total: u64) -> anyhow::Result<Self> {
+        let time_path = dir.join(TIME_FILE);
+        let before = if time_path.exists() { read_json::<TrainingTime>(&time_path)?.seconds } else { 0.0 };
+        Ok(Self { inner: TrainingProgress::new(label, done, total), time_path, before, started: Instant::now() })
+    }
+
+    fn seconds(&self) -> f64 {
+        self.before + self.started.elapsed().as_secs_f64()
+    }
+
+    /// Records the run as finished; returns its total training time.
+    fn finish(self) -> anyhow::Result<f64> {
+        self.inner.finish();
+        let time = TrainingTime { seconds: self.seconds(), finished: true };
+        write_json(&self.time_path, &time)?;
+        Ok(time.seconds)
+    }
+
+    fn record(&mut self) {
+        let time = TrainingTime { seconds: self.seconds(), finished: false };
+        if let Err(e) = write_json(&self.time_path, &time) {
+            self.inner.println(&format!("warning: {e:#}"));
+        }
+    }
+}
+
+impl CnnObserver for TimedProgress {
+    fn step(&mut self, report: &CnnStepReport, total: u64) {
+        self.inner.cnn_step(report, total);
+    }
+
+    fn checkpoint(&mut self, step: u64, dir: &Path) {
+        TrainingObserver::checkpoint(&mut self.inner, step, dir);
+        self.record();
+    }
+}
+
+impl TrainingObserver for TimedProgress {
+    fn step(&mut self, report: &StepReport, total: u64) {
+        self.inner.step(report, total);
+    }
+
+    fn validation(&mut self, step: u64, summary: &EvaluationSummary) {
+        self.inner.validation(step, summary);
+    }
+
+    fn checkpoint(&mut self, step: u64, dir: &Path) {
+        self.inner.checkpoint(step, dir);
+        self.record();
+    }
+}
