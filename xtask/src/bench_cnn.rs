@@ -70,11 +70,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let case = CASES.iter().find(|c| c.name == name).with_context(|| format!("unknown case `{name}` (2d, 3d)"))?;
         let ours = bench_ours(case, &args)?;
         println!(
-            "amber-cnn {:>2} {}: train {:7.3} s/step (forward {:.3} s)  infer {:7.3} s  ({} parameters) [load average {}]",
+            "amber-cnn {:>2} {}: train {:7.3} s/step (forward {:.3} s, backward {:.3} s)  infer {:7.3} s  ({} parameters) [load average {}]",
             case.name,
             ours["input_shape"],
             ours["train_s_median"].as_f64().unwrap_or(f64::NAN),
             ours["train_forward_s_median"].as_f64().unwrap_or(f64::NAN),
+            ours["train_backward_s_median"].as_f64().unwrap_or(f64::NAN),
             ours["infer_s_median"].as_f64().unwrap_or(f64::NAN),
             ours["parameters"],
             ours["load_average_after"].as_str().unwrap_or("?"),
@@ -149,6 +150,16 @@ fn bench_ours(case: &Case, args: &Args) -> anyhow::Result<Value> {
     let train = time(args, &mut train_step)?;
     // The timed steps' forward passes (after the warm-up).
     let forward_s = forward_s.split_off(args.warmup.min(forward_s.len()));
+    // Forward and backward without the optimiser: the rest of a step is clipping and Adam.
+    let mut backward_s = Vec::new();
+    time(args, &mut || -> anyhow::Result<()> {
+        let loss = CnnLoss::Mse.loss(&net.forward_train(&x)?, &y, &mask)?;
+        let started = Instant::now();
+        drop(loss.backward()?);
+        backward_s.push(started.elapsed().as_secs_f64());
+        Ok(())
+    })?;
+    let backward_s = backward_s.split_off(args.warmup.min(backward_s.len()));
     let infer = time(args, &mut || -> anyhow::Result<()> {
         drop(net.forward(&x)?);
         Ok(())
@@ -159,6 +170,7 @@ fn bench_ours(case: &Case, args: &Args) -> anyhow::Result<Value> {
         "train_s_median": median(&train),
         "train_s_all": train,
         "train_forward_s_median": median(&forward_s),
+        "train_backward_s_median": median(&backward_s),
         "infer_s_median": median(&infer),
         "infer_s_all": infer,
         "load_average_before": load_average_before,
@@ -183,7 +195,7 @@ fn time(args: &Args, step: &mut dyn FnMut() -> anyhow::Result<()>) -> anyhow::Re
 fn median(v: &[f64]) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
-    s[s.len() / 2]
+    s.get(s.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// `/proc/loadavg`: how busy the shared machine was around a measurement.

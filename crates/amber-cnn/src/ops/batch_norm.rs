@@ -8,7 +8,7 @@ use candle_core::backend::BackendStorage;
 use candle_core::{CpuStorage, CustomOp3, DType, Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Float, cpu_slice, float_dtype, with_slice};
+use super::{Float, build_by_planes, cpu_slice, float_dtype, with_slice};
 
 /// Added to the variance (PyTorch's default).
 pub const EPSILON: f64 = 1e-5;
@@ -97,17 +97,15 @@ struct BatchNormRelu {
 impl BatchNormRelu {
     fn forward<T: Float>(&self, x: &[T], gamma: &[T], beta: &[T], plane: usize) -> Vec<T> {
         let channels = self.mean.len();
-        let mut y = vec![T::zero(); x.len()];
-        y.par_chunks_mut(plane).zip(x.par_chunks(plane)).enumerate().for_each(|(i, (y, x))| {
+        build_by_planes(x.len(), plane, |i, y| {
             let c = i % channels;
             let scale = gamma[c].to_f64() * self.rstd[c];
             let (scale, shift) = (T::from_f64(scale), T::from_f64(beta[c].to_f64() - self.mean[c] * scale));
-            for (y, &x) in y.iter_mut().zip(x) {
+            for (y, &x) in y.iter_mut().zip(&x[i * plane..(i + 1) * plane]) {
                 let v = x * scale + shift;
-                *y = if v > T::zero() { v } else { T::zero() };
+                y.write(if v > T::zero() { v } else { T::zero() });
             }
-        });
-        y
+        })
     }
 
     /// Gradients of x, γ and β from the output `y` (its sign is the ReLU mask) and `dy`.
@@ -133,8 +131,7 @@ impl BatchNormRelu {
             })
             .unzip();
         let count = (images * plane).max(1) as f64;
-        let mut dx = vec![T::zero(); x.len()];
-        dx.par_chunks_mut(plane).enumerate().for_each(|(i, dx)| {
+        let dx = build_by_planes(x.len(), plane, |i, dx| {
             let c = i % channels;
             let at = i * plane..(i + 1) * plane;
             // dx = γ·rstd·(g − Σg/M − x̂·Σg·x̂/M) with batch statistics, γ·rstd·g with fixed ones;
@@ -147,7 +144,7 @@ impl BatchNormRelu {
                 (T::from_f64(scale), T::from_f64(slope), T::from_f64(self.mean[c] * slope - mean_g));
             for ((dx, &x), (&y, &dy)) in dx.iter_mut().zip(&x[at.clone()]).zip(y[at.clone()].iter().zip(&dy[at])) {
                 let g = if y > T::zero() { dy } else { T::zero() };
-                *dx = (g - x * slope_t + offset_t) * scale_t;
+                dx.write((g - x * slope_t + offset_t) * scale_t);
             }
         });
         let to_t = |v: Vec<f64>| v.into_iter().map(T::from_f64).collect();

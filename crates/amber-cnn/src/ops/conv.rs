@@ -191,17 +191,7 @@ fn weight_grad<T: Float>(x: &[T], dy: &[T], n: usize, c: usize, o: usize, unfold
         let dy = Strided { ptr: dy[image * o * p + start..].as_ptr(), rows: p as isize, cols: 1 };
         // SAFETY: `acc` is this item's own accumulator; operands are in bounds.
         unsafe {
-            matmul(
-                o,
-                c * taps,
-                width,
-                acc.as_mut_ptr(),
-                c * taps,
-                true,
-                dy,
-                Strided::transposed(cols, width),
-                threads,
-            );
+            matmul(o, c * taps, width, acc.as_mut_ptr(), c * taps, true, dy, Strided::transposed(cols, width), threads);
         }
     })
 }

@@ -135,10 +135,10 @@ fn backward<T: Float>(x: &[T], w: &[T], dy: &[T], blocks: &Blocks, want_dx: bool
         // SAFETY: `acc` is this item's accumulator and the dx columns of this tile are written by
         // this item alone; operands are in bounds.
         unsafe {
-            matmul(c, o * k, t, acc.as_mut_ptr(), o * k, true, xs, Strided::transposed(&dz, t), threads);
+            matmul(c, o * k, t, acc.as_mut_ptr(), o * k, true, xs, Strided::transposed(dz, t), threads);
             if want_dx {
                 let dst = dx_ptr.ptr().add(image * c * p + range.start);
-                matmul(c, t, o * k, dst, p, false, Strided::row_major(w, o * k), Strided::row_major(&dz, t), threads);
+                matmul(c, t, o * k, dst, p, false, Strided::row_major(w, o * k), Strided::row_major(dz, t), threads);
             }
         }
     });

@@ -19,7 +19,10 @@ pub use conv::conv;
 pub use conv_transpose::conv_transpose2;
 pub use pool::max_pool2;
 
+use std::mem::MaybeUninit;
+
 use candle_core::{CpuStorage, DType, Layout, Result, Storage, Tensor, WithDType, bail};
+use rayon::prelude::*;
 
 /// The float types the ops run on: f32 for training, f64 for gradient checks.
 pub(crate) trait Float: WithDType {}
@@ -64,6 +67,16 @@ fn image_dims(op: &str, dims: &[usize], spatial_axes: usize) -> Result<(usize, u
         bail!("{op}: expected a (N, C, {spatial_axes} non-empty spatial axes) tensor, got shape {dims:?}");
     }
     Ok((dims[0], dims[1], dims[2..].to_vec()))
+}
+
+/// A vector of `len` values built plane by plane in parallel: `fill(i, plane)` must write every
+/// slot of plane `i` (`len` is a multiple of `plane`). Saves the zero fill of `vec![0; len]`.
+fn build_by_planes<T: Float>(len: usize, plane: usize, fill: impl Fn(usize, &mut [MaybeUninit<T>]) + Sync) -> Vec<T> {
+    let mut out: Vec<T> = Vec::with_capacity(len);
+    out.spare_capacity_mut()[..len].par_chunks_mut(plane.max(1)).enumerate().for_each(|(i, p)| fill(i, p));
+    // SAFETY: every caller's `fill` writes every slot of its plane, and the planes cover `len`.
+    unsafe { out.set_len(len) };
+    out
 }
 
 /// A raw pointer that work items running in parallel write through, each into its own disjoint

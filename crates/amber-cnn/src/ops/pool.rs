@@ -6,7 +6,7 @@ use candle_core::backend::BackendStorage;
 use candle_core::{CpuStorage, CustomOp1, DType, Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Float, cpu_slice, float_dtype, image_dims, with_slice};
+use super::{Float, build_by_planes, cpu_slice, float_dtype, image_dims, with_slice};
 
 /// `x (N, C, spatial...)` → `(N, C, spatial/2...)`, the maximum of every 2×…×2 window.
 pub fn max_pool2(x: &Tensor) -> Result<Tensor> {
@@ -71,8 +71,9 @@ fn strides(shape: &[usize]) -> Vec<usize> {
 }
 
 fn forward<T: Float>(x: &[T], windows: &Windows) -> Vec<T> {
-    let mut out = vec![T::zero(); x.len() / windows.input_len() * windows.output_len()];
-    out.par_chunks_mut(windows.output_len()).zip(x.par_chunks(windows.input_len())).for_each(|(out, x)| {
+    let planes = x.len() / windows.input_len();
+    build_by_planes(planes * windows.output_len(), windows.output_len(), |i, out| {
+        let x = &x[i * windows.input_len()..(i + 1) * windows.input_len()];
         windows.for_each(|o, start| {
             let mut best = x[start];
             for &d in &windows.offsets[1..] {
@@ -80,10 +81,9 @@ fn forward<T: Float>(x: &[T], windows: &Windows) -> Vec<T> {
                     best = x[start + d];
                 }
             }
-            out[o] = best;
+            out[o].write(best);
         });
-    });
-    out
+    })
 }
 
 fn backward<T: Float>(x: &[T], y: &[T], dy: &[T], windows: &Windows) -> Vec<T> {
