@@ -69,6 +69,10 @@ struct PoissonArgs {
     /// A JSON file of training-config fields overriding the profile's for every run.
     #[arg(long)]
     config: Option<PathBuf>,
+    /// Skip a generation step whose field exceeds the element budget, as the paper does,
+    /// instead of scaling the field to the budget (the default outside the paper profile).
+    #[arg(long)]
+    skip_over_budget: bool,
     /// Retrain and re-evaluate even when cached.
     #[arg(long)]
     force: bool,
@@ -118,6 +122,9 @@ fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
         experiment.test_problems = args.test_problems;
     }
     experiment.test_set = args.test_set;
+    if args.skip_over_budget {
+        experiment.scale_to_budget = false;
+    }
     experiment.force = args.force;
     experiment.out = args.out;
     run_and_report(&experiment)

@@ -17,7 +17,7 @@ use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::report::{commit, machine, merge_json};
 use crate::results::{ExperimentResults, RunKey, RunResult};
-use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, train_amber, train_cnn};
+use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 
 /// The two viewpoints of the galleries.
 const VIEWS: [View; 2] =
@@ -42,6 +42,10 @@ pub struct ConsoleExperiment {
     pub overrides: serde_json::Value,
     /// Fields merged into every CNN run's config.
     pub cnn_overrides: serde_json::Value,
+    /// At evaluation, scale a predicted field whose element count exceeds the budget to the
+    /// budget and mesh it (spec §11, the later version) instead of skipping the step (the
+    /// paper). Training is not affected.
+    pub scale_to_budget: bool,
     /// Retrain and re-evaluate even when cached.
     pub force: bool,
 }
@@ -64,6 +68,7 @@ impl ConsoleExperiment {
             out: PathBuf::from("results/console"),
             overrides: serde_json::json!({}),
             cnn_overrides: serde_json::json!({}),
+            scale_to_budget: profile != Profile::Paper,
             force: false,
         }
     }
@@ -115,7 +120,7 @@ impl ConsoleExperiment {
         }
         let test_split = if has_test_split(&self.data) { ConsoleSplit::Test } else { ConsoleSplit::Val };
         let test = self.load(test_split, usize::MAX)?;
-        let test_name = format!("console {} ({} parts)", test_split.name(), test.len());
+        let test_name = evaluation_name(format!("console {} ({} parts)", test_split.name(), test.len()), self.scale_to_budget);
         let mut runs = Vec::new();
         let mut configs = Vec::new();
         let mut rows: Vec<(String, Vec<Vec<Mesh3>>)> = Vec::new();
@@ -125,7 +130,7 @@ impl ConsoleExperiment {
                 let data_key = ("data", serde_json::json!({ "dir": self.data, "train_set": self.train_set }));
                 let run =
                     Run::new(&self.runs_root, "console", "console", spec, &config, data_key, &test_name, self.force)?;
-                let evaluated = run.train_and_evaluate(&config, &test, |dir, label| match &config {
+                let evaluated = run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| match &config {
                     RunConfig::Amber(c) => {
                         let problems = || {
                             Ok((self.load(ConsoleSplit::Train, c.data.train_problems)?, self.load(ConsoleSplit::Val, c.data.val_problems)?))

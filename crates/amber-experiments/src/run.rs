@@ -64,6 +64,12 @@ impl RunConfig {
     }
 }
 
+/// The name an evaluation is cached under: the test set's, and how over-budget fields are
+/// treated when they are scaled.
+pub(crate) fn evaluation_name(test_name: String, scale_to_budget: bool) -> String {
+    if scale_to_budget { format!("{test_name}, fields scaled to the budget") } else { test_name }
+}
+
 /// A run's evaluation on a test set, as cached in its directory.
 #[derive(Serialize, Deserialize)]
 pub(crate) struct CachedEvaluation {
@@ -107,17 +113,21 @@ impl Run {
         if force && dir.exists() {
             std::fs::remove_dir_all(&dir).with_context(|| format!("{}: cannot remove for --force", dir.display()))?;
         }
+        // Evaluations are keyed by the test set and how it is evaluated.
         let eval_dir = dir.join(format!("eval-{}", config_hash(&serde_json::json!(test_name))));
         let label = format!("{} {setting} seed {}", spec.label(), config.seed());
         Ok(Self { dir, label, test_name: test_name.into(), eval_dir })
     }
 
     /// Trains the run with `train` (which must resume or reuse what `dir` holds; it returns the
-    /// training time), then evaluates the model on `test`; a cached evaluation skips both.
+    /// training time), then evaluates the model on `test`, scaling fields over the element
+    /// budget to it if `scale_to_budget` (spec §11) instead of skipping the step; a cached
+    /// evaluation skips both.
     pub fn train_and_evaluate<const D: usize, P: Problem<D>>(
         &self,
         config: &RunConfig,
         test: &[P],
+        scale_to_budget: bool,
         train: impl FnOnce(&Path, &str) -> anyhow::Result<f64>,
     ) -> anyhow::Result<CachedEvaluation> {
         let cache = self.eval_dir.join("evaluation.json");
@@ -130,12 +140,14 @@ impl Run {
         let started = Instant::now();
         let rollouts = match config {
             RunConfig::Amber(config) => {
-                let model = AmberModel::load(&self.dir.join(MODEL_DIR))?;
+                let mut model = AmberModel::load(&self.dir.join(MODEL_DIR))?;
+                model.predictor.limits.scale_to_budget = scale_to_budget;
                 let evaluation = Evaluation::new(test, &model.predictor.limits)?;
                 evaluation.run(&model.network, &model.predictor, config.inference_steps)?.0
             }
             RunConfig::Cnn(_) => {
-                let model = CnnModel::load(&self.dir.join(MODEL_DIR))?;
+                let mut model = CnnModel::load(&self.dir.join(MODEL_DIR))?;
+                model.predictor.limits.scale_to_budget = scale_to_budget;
                 let references = Evaluation::new(test, &model.predictor.limits)?.references;
                 model.rollouts(test, &references)?
             }

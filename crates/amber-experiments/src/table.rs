@@ -54,6 +54,13 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
          it gives one.\n",
         results.experiment, results.profile
     );
+    if results.config["experiment"]["scale_to_budget"] == true {
+        md.push_str(
+            "Predicted fields whose estimated element count exceeds the budget (1.2 × the largest training expert) \
+             are scaled up to it at evaluation (the later version's remedy, spec §11) rather than skipped as in the \
+             paper; training is unchanged.\n\n",
+        );
+    }
     let _ = write!(md, "| method |");
     for c in &columns {
         let _ = write!(md, " {c} | paper |");

@@ -101,8 +101,13 @@ impl Problem<2> for PoissonProblem {
 pub struct MeshLimits {
     /// h_min: predicted sizes are clipped below at this size.
     pub min_size: f64,
-    /// Fields whose estimated element count Σ|K|/V(h) exceeds this are not meshed.
+    /// Fields whose estimated element count Σ|K|/V(h) exceeds this are not meshed as they are.
     pub max_elements: usize,
+    /// What becomes of such a field: `false` (the paper) skips the step; `true` (the later
+    /// version, spec §11) scales every size up by one factor so that the estimate meets the
+    /// budget, and meshes that.
+    #[serde(default)]
+    pub scale_to_budget: bool,
 }
 
 impl MeshLimits {
@@ -120,7 +125,11 @@ impl MeshLimits {
             largest = largest.max(expert.num_elements());
         }
         sizes.sort_by(f64::total_cmp);
-        Self { min_size: quantile(&sizes, min_size_quantile), max_elements: (budget_factor * largest as f64) as usize }
+        Self {
+            min_size: quantile(&sizes, min_size_quantile),
+            max_elements: (budget_factor * largest as f64) as usize,
+            scale_to_budget: false,
+        }
     }
 
     /// The generator's own hard cap: a safety net well above the budget (the estimate is only
@@ -198,8 +207,11 @@ pub enum StepOutcome<const D: usize> {
     Failed { reason: String },
 }
 
+/// Fraction of the element budget a field scaled to the budget aims at.
+const BUDGET_TARGET: f64 = 0.95;
+
 /// One generation step from `mesh` with the predicted per-element `sizes`: clip below at h_min,
-/// check the element budget, mesh.
+/// check the element budget (skip, or scale to it, as `limits` says), mesh.
 pub fn generation_step<const D: usize, P: Problem<D> + ?Sized>(
     problem: &P,
     mesh: &Mesh<D>,
@@ -211,7 +223,12 @@ pub fn generation_step<const D: usize, P: Problem<D> + ?Sized>(
     sizes.iter_mut().for_each(|h| *h = h.max(limits.min_size));
     let estimated_elements = estimated_element_count(mesh, &sizes);
     if estimated_elements > limits.max_elements as f64 {
-        return StepOutcome::OverBudget { estimated_elements };
+        if !limits.scale_to_budget || !estimated_elements.is_finite() {
+            return StepOutcome::OverBudget { estimated_elements };
+        }
+        // The count goes as h^-D: aim a little below the budget, the estimate being an estimate.
+        let factor = (estimated_elements / (BUDGET_TARGET * limits.max_elements as f64)).powf(1.0 / D as f64);
+        sizes.iter_mut().for_each(|h| *h *= factor);
     }
     let cap = limits.generator_cap();
     match problem.remesh(mesh, sizes, cap) {

@@ -194,3 +194,20 @@ fn rollouts_return_every_mesh_with_finite_metrics() {
     let from_file: Vec<f64> = out.iter().map(|r| r.steps[steps - 1].metrics.normalised_dcd).collect();
     assert!((from_file.iter().sum::<f64>() / 2.0 - last.normalised_dcd).abs() < 1e-9);
 }
+
+#[test]
+fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
+    let problem = problems(&[3]).remove(0);
+    let m0 = amber_train::Problem::initial_mesh(&problem).clone();
+    let mut limits = amber_train::MeshLimits { min_size: 1e-6, max_elements: 2_000, scale_to_budget: false };
+    // 0.005 everywhere asks for ~70k triangles on the L-shape.
+    let fine = vec![0.005; m0.num_elements()];
+    let outcome = amber_train::generation_step(&problem, &m0, fine.clone(), &limits);
+    assert!(matches!(outcome, amber_train::StepOutcome::OverBudget { estimated_elements } if estimated_elements > 50_000.0));
+    limits.scale_to_budget = true;
+    let amber_train::StepOutcome::Meshed(mesh) = amber_train::generation_step(&problem, &m0, fine, &limits) else {
+        panic!("a field scaled to the budget is meshed")
+    };
+    let n = mesh.num_elements();
+    assert!((1_400..=2_200).contains(&n), "{n} elements for a budget of 2,000 (aiming at 95 %)");
+}
