@@ -11050,8 +11050,17 @@ enum tetgenmesh::locateresult tetgenmesh::locate(point searchpt,
   }
   assert(searchtet->ver != 4);
 
+  // amber: a walk through more tetrahedra than the mesh holds (ten times over) is going round
+  // in circles (seen after degenerate insertions during refinement); stop with TetGen's
+  // "internal error" code instead of hanging.
+  long amber_steps = 0;
+  long amber_max_steps = 10 * (tetrahedrons->items + 1000);
+
   // Walk through tetrahedra to locate the point.
   while (true) {
+    if (++amber_steps > amber_max_steps) {
+      terminatetetgen(this, 2); // amber
+    }
 
     toppo = oppo(*searchtet);
     

@@ -14,7 +14,7 @@ use rstar::primitives::GeomWithData;
 
 use super::remesh::{RemeshError, RemeshParams, remesh};
 use super::surface::{Surface, SurfaceDefect};
-use super::tetgen::{TetgenError, TetgenSwitches, delaunay, tetrahedralize};
+use super::tetgen::{Quality, TetgenError, TetgenSwitches, delaunay, tetrahedralize};
 use crate::SizingField;
 use amber_mesh::Mesh3;
 
@@ -40,7 +40,7 @@ impl Default for Mesh3dParams {
     fn default() -> Self {
         // Fitted on the Console parts with the expert's own field (`cargo xtask bench mesher3d`):
         // ε = 0.05 mm keeps the enclosed volume within 0.1 % and the bends no finer than the
-        // expert's; four remeshing rounds give the same meshes as six, faster.
+        // expert's; four remeshing rounds give meshes as good as six, faster.
         Self {
             remesh: RemeshParams { iterations: 4, ..RemeshParams::default() },
             curvature_tolerance: 0.05,
@@ -70,7 +70,7 @@ pub enum Mesh3dError {
     InvalidSize { at: [f64; 3], value: f64 },
     /// The field asks for more elements than the cap (`estimated` is the surface-based
     /// estimate, or the count TetGen reached).
-    #[error("the mesh would exceed the cap of {cap} elements (about {estimated} needed; sizes too small?)")]
+    #[error("the mesh would exceed the cap of {cap} elements (at least {estimated} needed; sizes too small?)")]
     TooManyElements { cap: usize, estimated: usize },
     /// The surface remesher failed.
     #[error("surface remeshing failed: {0}")]
@@ -103,7 +103,8 @@ impl From<Mesh3dError> for crate::MeshgenError {
 }
 
 /// Meshes the solid bounded by `reference` with tets whose sizes follow `field` (target edge
-/// lengths, spec §0): [`adapt_surface`], then [`fill_surface`]. Deterministic (no randomness).
+/// lengths, spec §0): [`adapt_surface`], then [`fill_surface`]. Deterministic: the same
+/// inputs give the same mesh.
 pub fn generate_3d(
     reference: &Surface,
     field: &impl SizingField<3>,
@@ -113,8 +114,8 @@ pub fn generate_3d(
 }
 
 /// The first stage of [`generate_3d`]: validates `reference` unless it has been (closed,
-/// manifold, oriented, no self-intersections) and remeshes it to `field` capped by curvature (h ≤ √(8·r·ε)),
-/// refusing fields that would need more triangles than the element cap allows.
+/// manifold, oriented, no self-intersections) and remeshes it to `field` capped by curvature
+/// (h ≤ √(8·r·ε)), refusing fields that would need more triangles than the element cap allows.
 pub fn adapt_surface(
     reference: &Surface,
     field: &impl SizingField<3>,
@@ -133,10 +134,6 @@ pub fn adapt_surface(
     // A closed surface of T triangles bounds at least T/4 tets: more triangles than 4·cap
     // cannot make an acceptable mesh.
     let max_triangles = params.remesh.max_triangles.min(params.max_elements.saturating_mul(4));
-    let estimated = estimated_triangles(reference, &field)?;
-    if estimated > max_triangles as f64 {
-        return Err(Mesh3dError::TooManyElements { cap: params.max_elements, estimated: (estimated / 4.0) as usize });
-    }
     let remesh_params = RemeshParams { max_triangles, ..params.remesh };
     remesh(reference, &field, &remesh_params).map_err(|e| match e {
         RemeshError::TooManyTriangles { cap } => {
@@ -149,7 +146,8 @@ pub fn adapt_surface(
 /// The second stage of [`generate_3d`]: fills a valid closed `surface` with tets (TetGen, the
 /// surface kept as it is), sized by `field` at the surface vertices and, for new points, by
 /// linear interpolation in a convex background mesh of the surface vertices. The result is
-/// positively oriented; more than `params.max_elements` tets is an error.
+/// positively oriented; more than `params.max_elements` tets is an error. When TetGen's quality
+/// refinement fails with its internal error, the volume is retried with looser bounds.
 pub fn fill_surface(
     surface: &Surface,
     field: &impl SizingField<3>,
@@ -164,7 +162,23 @@ pub fn fill_surface(
     // TetGen's Steiner-point cap: a mesh with `max_elements` tets has far fewer points, so
     // reaching it means the cap is exceeded.
     let switches = TetgenSwitches { max_steiner_points: Some(params.max_elements), ..params.switches };
-    let out = tetrahedralize(&surface.to_plc(), Some(&sizes), Some((&background, &background_sizes)), &switches)?;
+    let plc = surface.to_plc();
+    let background = Some((&background, &background_sizes[..]));
+    let mut out = tetrahedralize(&plc, Some(&sizes), background, &switches);
+    for quality in FALLBACK_QUALITY {
+        match out {
+            Err(TetgenError::Internal) if switches.quality.is_some() => {
+                out = tetrahedralize(
+                    &plc,
+                    Some(&sizes),
+                    background,
+                    &TetgenSwitches { quality: Some(quality), ..switches },
+                );
+            }
+            _ => break,
+        }
+    }
+    let out = out?;
     let tets = out.mesh.num_elements();
     if tets > params.max_elements {
         return Err(Mesh3dError::TooManyElements { cap: params.max_elements, estimated: tets });
@@ -172,22 +186,17 @@ pub fn fill_surface(
     Ok(out.mesh)
 }
 
+/// Looser quality bounds for TetGen, tried in turn when its refinement fails with an internal
+/// error: it rarely does with `-q1.4/20` on a remeshed surface (1 of 105 Console meshes with
+/// varied fields), and never so far with 1.5/18°.
+const FALLBACK_QUALITY: [Quality; 2] = [
+    Quality { max_radius_edge_ratio: 1.5, min_dihedral_deg: 18.0 },
+    Quality { max_radius_edge_ratio: 2.0, min_dihedral_deg: 0.0 },
+];
+
 fn checked_size(field: &impl SizingField<3>, p: [f64; 3]) -> Result<f64, Mesh3dError> {
     let h = field.size_at(p);
     if h.is_finite() && h > 0.0 { Ok(h) } else { Err(Mesh3dError::InvalidSize { at: p, value: h }) }
-}
-
-/// The remeshed surface's triangle count if every reference triangle were covered by
-/// triangles of the size at its centroid.
-fn estimated_triangles(reference: &Surface, field: &impl SizingField<3>) -> Result<f64, Mesh3dError> {
-    let v = reference.vertices();
-    let mut total = 0.0;
-    for t in reference.triangles() {
-        let [a, b, c] = t.map(|i| v[i as usize]);
-        let h = checked_size(field, centroid(a, b, c))?;
-        total += 0.5 * norm(cross(sub(b, a), sub(c, a))) / (3f64.sqrt() / 4.0 * h * h);
-    }
-    Ok(total)
 }
 
 /// The convex background mesh for TetGen's `-m`: the Delaunay tetrahedralisation of the
@@ -340,6 +349,8 @@ mod tests {
     fn cube_is_meshed_to_a_graded_field() {
         let h = |p: [f64; 3]| 0.08 + 0.15 * p[0];
         let mesh = generate_3d(&cube(), &FnSize(h), &Mesh3dParams::default()).unwrap();
+        let again = generate_3d(&cube(), &FnSize(h), &Mesh3dParams::default()).unwrap();
+        assert_eq!((mesh.vertices(), mesh.cells()), (again.vertices(), again.cells()), "not deterministic");
         assert!((mesh.total_volume() - 1.0).abs() < 1e-12, "volume {}", mesh.total_volume());
         let min_dihedral = mesh.min_angles().into_iter().fold(f64::INFINITY, f64::min);
         assert!(min_dihedral > 5.0, "min dihedral {min_dihedral}");
@@ -424,6 +435,11 @@ mod tests {
         );
         assert!((0.8..1.3).contains(&ratio) && (0.85..1.15).contains(&median), "{ratio} {median}");
         assert!(min_dihedral > 5.0 && volume_error.abs() < 5e-3, "{min_dihedral} {volume_error}");
+        // 0.7 × the expert's field: TetGen's 1.4/20° refinement fails on this surface with its
+        // internal error (a point-location walk going in circles); the looser bound meshes it.
+        let finer = FnSize(|x: [f64; 3]| 0.7 * field.size_at(x));
+        let mesh = generate_3d(&reference, &finer, &Mesh3dParams::default()).unwrap();
+        assert!((mesh.total_volume() / reference.enclosed_volume() - 1.0).abs() < 5e-3);
     }
 
     /// Closed, 2-manifold, one outward component without self-intersections: `validate` checks
@@ -435,9 +451,15 @@ mod tests {
     }
 
     proptest! {
-        #![proptest_config(ProptestConfig { cases: 3, rng_seed: RngSeed::Fixed(8), failure_persistence: None, ..ProptestConfig::default() })]
+        #![proptest_config(ProptestConfig {
+            cases: 3,
+            rng_seed: RngSeed::Fixed(8),
+            failure_persistence: None,
+            ..ProptestConfig::default()
+        })]
 
-        /// The remesher on shipped parts with random smooth fields (0.6–6 mm, waves of 10–40 mm).
+        /// The remesher on shipped parts with random smooth fields (0.16–5.4 mm, waves of
+        /// 10–40 mm), seeded.
         #[test]
         fn remeshed_console_surfaces_are_valid_for_random_smooth_fields(
             h0 in 0.8..3.0f64, amplitude in 0.0..0.8f64, wavelength in 10.0..40.0f64, part in 0..2usize,
@@ -445,7 +467,8 @@ mod tests {
             let name = ["train/002", "val/002"][part];
             let Some((data, reference)) = console_part(name) else { return Ok(()) };
             let k = std::f64::consts::TAU / wavelength;
-            let field = FnSize(move |x: [f64; 3]| h0 * (1.0 + amplitude * (k * x[0]).sin() * (k * x[1] + 0.5 * k * x[2]).cos()));
+            let wave = move |x: [f64; 3]| (k * x[0]).sin() * (k * x[1] + 0.5 * k * x[2]).cos();
+            let field = FnSize(move |x: [f64; 3]| h0 * (1.0 + amplitude * wave(x)));
             let surface = adapt_surface(&reference, &field, &Mesh3dParams::default()).unwrap();
             assert_valid_surface(&surface, &data.join(name));
             let volume_error = surface.enclosed_volume() / reference.enclosed_volume() - 1.0;

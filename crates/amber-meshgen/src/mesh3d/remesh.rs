@@ -3,13 +3,17 @@
 //! surface — gets a boundary that already has the target sizes (spec §2, 3D).
 //!
 //! Every iteration splits edges longer than 4/3·h, collapses edges shorter than 4/5·h, flips
-//! edges toward valence 6, smooths tangentially and projects back onto the reference. CAD
-//! faces are never merged: every vertex stays on its own face (projection onto that face
-//! only, which keeps the two sides of a thin sheet apart), vertices on the curve between two
-//! faces stay on that curve, and corners (vertices of three or more faces) never move.
-//! No operation may make the surface intersect itself: collapses and flips whose new triangles
-//! would cross another are refused, and vertices whose move (split or smoothing) made
-//! triangles cross go back to where they were safe.
+//! edges toward valence 6 (or toward better-shaped triangles), smooths tangentially and
+//! projects back onto the reference; h is evaluated at the vertices and an edge's target is
+//! the mean of its ends. CAD faces are never merged: every vertex stays on its own face
+//! (projection onto that face only, which keeps the two sides of a thin sheet apart), vertices
+//! on the curve between two faces stay on that curve, and corners (vertices of three or more
+//! faces) never move. No operation may make the surface intersect itself or turn a triangle
+//! over: collapses and flips whose new triangles would cross another are refused, and vertices
+//! whose move (split or smoothing) made triangles cross go back to where they were safe. Inside
+//! a planar face the orientation check is enough — a planar triangulation with a fixed boundary
+//! whose triangles all keep their orientation cannot overlap itself — so the costly crossing
+//! tests run only on curved faces.
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -67,6 +71,10 @@ pub fn remesh<S: SizingField<3>>(
 ) -> Result<Surface, RemeshError> {
     let context = Context { sizing, projector: Projector::new(reference), params: *params };
     let mut mesh = WorkMesh::new(reference, &context)?;
+    // Refuse at once a field that would need more triangles than the cap.
+    if mesh.estimated_triangles() > params.max_triangles as f64 {
+        return Err(RemeshError::TooManyTriangles { cap: params.max_triangles });
+    }
     for _ in 0..params.iterations {
         mesh.split_long_edges(&context)?;
         mesh.collapse_short_edges(&context);
@@ -293,6 +301,18 @@ impl WorkMesh {
             live_triangles: s.triangles().len(),
             around,
         })
+    }
+
+    /// The triangle count if every triangle were covered by equilateral triangles of the mean
+    /// size at its corners.
+    fn estimated_triangles(&self) -> f64 {
+        let live = (0..self.triangles.len()).filter(|&t| self.triangle_alive[t]);
+        live.map(|t| {
+            let tri = self.triangles[t];
+            let h = tri.iter().map(|&v| self.h[v as usize]).sum::<f64>() / 3.0;
+            0.5 * norm(self.normal(tri)) / (3f64.sqrt() / 4.0 * h * h)
+        })
+        .sum()
     }
 
     /// Every edge once, as (smaller, larger) vertex index.
