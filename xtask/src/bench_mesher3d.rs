@@ -115,7 +115,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let acceptance = serde_json::json!({
         "tets_within_0.8_1.3": parts.iter().filter(|p| (0.8..=1.3).contains(&p.tets_over_expert)).count(),
-        "size_ratio_median_within_0.85_1.15": parts.iter().filter(|p| (0.85..=1.15).contains(&p.size_ratio_median)).count(),
+        "size_ratio_median_within_0.85_1.15":
+            parts.iter().filter(|p| (0.85..=1.15).contains(&p.size_ratio_median)).count(),
         "no_tet_below_5_deg": parts.iter().filter(|p| p.tets_below_5_deg == 0).count(),
         "volume_within_0.5_percent": parts.iter().filter(|p| p.volume_error.abs() <= 5e-3).count(),
         "parts": parts.len(),
