@@ -16,7 +16,7 @@ use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::report::{commit, machine, merge_json};
-use crate::results::{ExperimentResults, RunKey, RunResult};
+use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 
 /// The two viewpoints of the galleries.
@@ -143,17 +143,7 @@ impl ConsoleExperiment {
                     "method": spec.method, "variant": spec.variant.name, "seed": seed, "run_dir": run.dir,
                     "training": config.to_json()?,
                 }));
-                runs.push(RunResult::new(
-                    RunKey {
-                        method: &spec.method.name(),
-                        variant: &spec.variant.name,
-                        difficulty: "console",
-                        seed,
-                        train_seconds: evaluated.train_seconds,
-                        eval_seconds: evaluated.eval_seconds,
-                    },
-                    &evaluated.problems,
-                ));
+                runs.push(evaluated.result(spec, "console", seed));
                 if seed == 0 && spec.variant.name == "default" {
                     rows.push((spec.label(), run.gallery_meshes(config.inference_steps())?));
                 }

@@ -15,7 +15,7 @@ use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::progress::item_bar;
 use crate::report::{commit, machine, merge_json, read_json};
-use crate::results::{ExperimentResults, RunKey, RunResult};
+use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 
 /// Everything an invocation of the Poisson experiment decides.
@@ -198,17 +198,7 @@ impl PoissonExperiment {
                         "method": spec.method, "variant": spec.variant.name, "difficulty": difficulty.name(),
                         "seed": seed, "run_dir": run.dir, "training": config.to_json()?,
                     }));
-                    runs.push(RunResult::new(
-                        RunKey {
-                            method: &spec.method.name(),
-                            variant: &spec.variant.name,
-                            difficulty: difficulty.name(),
-                            seed,
-                            train_seconds: evaluated.train_seconds,
-                            eval_seconds: evaluated.eval_seconds,
-                        },
-                        &evaluated.problems,
-                    ));
+                    runs.push(evaluated.result(spec, difficulty.name(), seed));
                     if seed == 0 && spec.variant.name == "default" {
                         rows.push((spec.label(), run.gallery_meshes(config.inference_steps())?));
                     }

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use crate::method::MethodSpec;
 use crate::progress::TrainingProgress;
 use crate::report::{config_hash, read_json, write_json};
-use crate::results::ProblemEvaluation;
+use crate::results::{ProblemEvaluation, RunKey, RunResult};
 
 /// Test problems whose rollouts are kept as meshes (`.vtu`) and drawn in the gallery.
 pub(crate) const GALLERY_PROBLEMS: usize = 2;
@@ -77,6 +77,21 @@ pub(crate) struct CachedEvaluation {
     pub train_seconds: f64,
     pub eval_seconds: f64,
     pub problems: Vec<ProblemEvaluation>,
+}
+
+impl CachedEvaluation {
+    /// The run's row of `results.json`.
+    pub fn result(&self, spec: &MethodSpec, setting: &str, seed: usize) -> RunResult {
+        let key = RunKey {
+            method: &spec.method.name(),
+            variant: &spec.variant.name,
+            difficulty: setting,
+            seed,
+            train_seconds: self.train_seconds,
+            eval_seconds: self.eval_seconds,
+        };
+        RunResult::new(key, &self.problems)
+    }
 }
 
 /// A run directory: `<runs>/<task>/<setting>/<method>[-<variant>]/seed<r>-<hash>`, where the
