@@ -2,7 +2,7 @@
 //! training of every method × difficulty × seed, test rollouts, tables and plots under
 //! `results/poisson/`). Trained runs are cached under `data/runs/`, keyed by their config.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use amber_experiments::{ConsoleExperiment, ExperimentResults, Method, MethodSpec, PoissonExperiment, read_json};
 use amber_tasks::console::TrainSet;
@@ -98,9 +98,7 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
     }
     experiment.force = args.force;
     experiment.out = args.out;
-    let results = experiment.run()?;
-    print_runs(&results);
-    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
+    report(&experiment.run()?, &experiment.out);
     Ok(())
 }
 
@@ -127,7 +125,8 @@ fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     }
     experiment.force = args.force;
     experiment.out = args.out;
-    run_and_report(&experiment)
+    report(&experiment.run()?, &experiment.out);
+    Ok(())
 }
 
 #[derive(clap::Args, Debug)]
@@ -148,19 +147,12 @@ pub fn ablate(args: AblateArgs) -> anyhow::Result<()> {
     let mut experiment = PoissonExperiment::ablation(args.profile);
     experiment.force = args.force;
     experiment.out = args.out;
-    run_and_report(&experiment)
-}
-
-/// Runs the experiment and prints each run's headline numbers.
-fn run_and_report(experiment: &PoissonExperiment) -> anyhow::Result<()> {
-    let results = experiment.run()?;
-    print_runs(&results);
-    println!("wrote {}/{{results.json, table.md, *.png}}", experiment.out.display());
+    report(&experiment.run()?, &experiment.out);
     Ok(())
 }
 
-/// Prints each run's headline numbers.
-fn print_runs(results: &ExperimentResults) {
+/// Prints each run's headline numbers and where the outputs went.
+fn report(results: &ExperimentResults, out: &Path) {
     for run in &results.runs {
         println!(
             "{} {} seed {}: normalised DCD {:.3} [{:.3}, {:.3}], per step {:?}",
@@ -177,4 +169,5 @@ fn print_runs(results: &ExperimentResults) {
             run.dcd, run.dcd_initial, run.dcd_reconstruction, run.elements, run.expert_elements, run.failed_steps
         );
     }
+    println!("wrote {}/{{results.json, table.md, *.png}}", out.display());
 }

@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use amber_graph::FeatureSet;
 use amber_mesh::Mesh;
 use candle_core::{Device, Tensor};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
@@ -49,7 +50,6 @@ impl RngState {
     }
 
     pub(crate) fn restore(&self, path: &Path) -> Result<ChaCha8Rng> {
-        use rand::SeedableRng;
         let word_pos: u128 = self.word_pos.parse().map_err(|_| TrainError::Checkpoint {
             path: path.into(),
             message: format!("invalid generator word position `{}`", self.word_pos),
@@ -82,6 +82,26 @@ pub(crate) struct ProblemFingerprint {
     pub initial_elements: usize,
     pub expert_elements: usize,
     pub expert_volume: f64,
+}
+
+/// The fingerprints of a run's training problems, checked on resume.
+pub(crate) fn fingerprints<const D: usize, P: crate::Problem<D>>(problems: &[P]) -> Vec<ProblemFingerprint> {
+    problems
+        .iter()
+        .map(|p| ProblemFingerprint {
+            initial_elements: p.initial_mesh().num_elements(),
+            expert_elements: p.expert_mesh().num_elements(),
+            expert_volume: p.expert_mesh().total_volume(),
+        })
+        .collect()
+}
+
+/// A generator of the run's seed on its own stream (1: edge dropout, 2: buffer sampling,
+/// 3: the CNN's image subsets).
+pub(crate) fn seeded_stream(seed: u64, stream: u64) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(stream);
+    rng
 }
 
 /// Counts of buffer additions by outcome.

@@ -18,12 +18,11 @@ use amber_graph::{Aggregation, RunningMoments, VARIANCE_EPSILON};
 use amber_mesh::Mesh;
 use amber_meshgen::SizingField;
 use candle_core::{DType, Device, Tensor};
-use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE};
+use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, fingerprints, seeded_stream};
 use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::inference::metrics;
 use crate::model::{read_json, write_json};
@@ -418,24 +417,6 @@ pub struct CnnTraining<const D: usize, P: Problem<D>> {
     subset_rng: ChaCha8Rng,
 }
 
-fn fingerprints<const D: usize, P: Problem<D>>(problems: &[P]) -> Vec<ProblemFingerprint> {
-    problems
-        .iter()
-        .map(|p| ProblemFingerprint {
-            initial_elements: p.initial_mesh().num_elements(),
-            expert_elements: p.expert_mesh().num_elements(),
-            expert_volume: p.expert_mesh().total_volume(),
-        })
-        .collect()
-}
-
-/// The seeded generator of the image subsets (its own stream of the run's seed).
-fn subset_stream(seed: u64) -> ChaCha8Rng {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(3);
-    rng
-}
-
 impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
     /// Rasterises the problems, fits the input normaliser and the limits, and stacks the
     /// training images; the network is built by `network` from the predictor's configuration.
@@ -530,7 +511,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
             Self::prepare(&config, &problems, |p| Ok(UNet::init(p.network.clone(), config.seed, DType::F32)?))?;
         let optimiser = Adam::new(network.varmap(), config.max_grad_norm)?;
         Ok(Self {
-            subset_rng: subset_stream(config.seed),
+            subset_rng: seeded_stream(config.seed, 3),
             config,
             problems,
             network,

@@ -11,13 +11,12 @@ use amber_mesh::Mesh;
 use amber_mpn::{GraphInput, Mpn, MpnConfig, mse};
 use candle_core::{DType, Device, Tensor};
 use candle_nn::VarMap;
-use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::checkpoint::{
-    self, AdditionCounts, EntryRecord, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, TrainingState,
+    self, AdditionCounts, EntryRecord, OPTIMISER_FILE, RngState, STATE_FILE, TrainingState, fingerprints, seeded_stream,
 };
 use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::model::{WEIGHTS_FILE, read_json, write_json};
@@ -97,24 +96,6 @@ pub struct Training<const D: usize, P: Problem<D>> {
     additions: AdditionCounts,
 }
 
-/// A generator of the run's seed on its own stream.
-fn stream(seed: u64, stream: u64) -> ChaCha8Rng {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(stream);
-    rng
-}
-
-fn fingerprints<const D: usize, P: Problem<D>>(problems: &[P]) -> Vec<ProblemFingerprint> {
-    problems
-        .iter()
-        .map(|p| ProblemFingerprint {
-            initial_elements: p.initial_mesh().num_elements(),
-            expert_elements: p.expert_mesh().num_elements(),
-            expert_volume: p.expert_mesh().total_volume(),
-        })
-        .collect()
-}
-
 impl<const D: usize, P: Problem<D>> Training<D, P> {
     /// A fresh run on `problems`: h_min and the element budget from their experts, one
     /// protected buffer entry per problem (which also seed the normalisers), a freshly
@@ -144,8 +125,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let optimiser = Adam::new(&varmap, config.max_grad_norm)?;
         let mut training = Self {
             buffer: ReplayBuffer::new(config.buffer_capacity),
-            dropout_rng: stream(config.seed, 1),
-            buffer_rng: stream(config.seed, 2),
+            dropout_rng: seeded_stream(config.seed, 1),
+            buffer_rng: seeded_stream(config.seed, 2),
             config,
             network,
             varmap,

@@ -322,23 +322,11 @@ mod tests {
     use super::*;
     use crate::mesh3d::console_reference_surfaces;
     use crate::mesh3d::surface::StlFaceIds;
+    use super::super::unit_cube_triangles as cube_triangles;
     use crate::{ConstantSize, FnSize, MeshSizing};
     use proptest::prelude::*;
     use proptest::test_runner::RngSeed;
     use std::path::{Path, PathBuf};
-
-    /// The unit cube as 12 triangles, one CAD face per side (corners (i&1, i>>1&1, i>>2&1)).
-    fn cube_triangles() -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<i32>) {
-        let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
-        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let mut triangles = Vec::new();
-        let mut ids = Vec::new();
-        for (side, q) in quads.iter().enumerate() {
-            triangles.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
-            ids.extend([side as i32 + 1; 2]);
-        }
-        (v, triangles, ids)
-    }
 
     fn cube() -> Surface {
         let (v, t, ids) = cube_triangles();

@@ -41,3 +41,17 @@ fn console_reference_surfaces() -> Option<Vec<std::path::PathBuf>> {
     assert!(files.len() >= 21, "expected 19 train + 2 val surfaces, found {}", files.len());
     Some(files)
 }
+
+/// The unit cube as 12 triangles, one CAD face per side (corners (i&1, i>>1&1, i>>2&1)).
+#[cfg(test)]
+fn unit_cube_triangles() -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<i32>) {
+    let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let mut triangles = Vec::new();
+    let mut ids = Vec::new();
+    for (side, q) in quads.iter().enumerate() {
+        triangles.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
+        ids.extend([side as i32 + 1; 2]);
+    }
+    (v, triangles, ids)
+}

@@ -818,14 +818,7 @@ mod tests {
 
     /// The unit cube as 12 triangles, one CAD face per side.
     fn cube() -> Surface {
-        let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
-        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let mut triangles = Vec::new();
-        let mut ids = Vec::new();
-        for (side, q) in quads.iter().enumerate() {
-            triangles.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
-            ids.extend([side as i32 + 1; 2]);
-        }
+        let (v, triangles, ids) = super::super::unit_cube_triangles();
         let mut s = Surface::new(v, triangles, ids).unwrap();
         s.validate().unwrap();
         s
