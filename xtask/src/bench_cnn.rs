@@ -59,11 +59,6 @@ const CASES: [Case; 2] = [
 ];
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    // Never hand freed memory back (15 = mi_option_purge_delay, -1 = no purging): the U-Net's
-    // activations are freed and reallocated every step, and re-faulting their pages cost 13 % of
-    // a step (measured with perf).
-    // SAFETY: sets a process-wide allocator option; mimalloc reads it at each purge.
-    unsafe { libmimalloc_sys::mi_option_set(15, -1) };
     rayon::ThreadPoolBuilder::new().num_threads(args.threads).build_global().context("starting the thread pool")?;
     let mut results = Vec::new();
     for name in &args.cases {

@@ -37,6 +37,12 @@ struct ConsoleArgs {
     /// Methods, comma-separated (default: the profile's).
     #[arg(long, value_delimiter = ',')]
     methods: Vec<Method>,
+    /// A JSON file of training-config fields overriding the profile's for every AMBER run.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// A JSON file of config fields overriding the profile's for every CNN run.
+    #[arg(long)]
+    cnn_config: Option<PathBuf>,
     /// Retrain and re-evaluate even when cached.
     #[arg(long)]
     force: bool,
@@ -66,9 +72,12 @@ struct PoissonArgs {
     /// Evaluate on the first N test problems only.
     #[arg(long)]
     test_problems: Option<usize>,
-    /// A JSON file of training-config fields overriding the profile's for every run.
+    /// A JSON file of training-config fields overriding the profile's for every AMBER run.
     #[arg(long)]
     config: Option<PathBuf>,
+    /// A JSON file of config fields overriding the profile's for every CNN run.
+    #[arg(long)]
+    cnn_config: Option<PathBuf>,
     /// Skip a generation step whose field exceeds the element budget, as the paper does,
     /// instead of scaling the field to the budget (the default outside the paper profile).
     #[arg(long)]
@@ -96,6 +105,12 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
     if !args.methods.is_empty() {
         experiment.methods = args.methods.into_iter().map(MethodSpec::plain).collect();
     }
+    if let Some(config) = &args.config {
+        experiment.overrides = read_json(config)?;
+    }
+    if let Some(config) = &args.cnn_config {
+        experiment.cnn_overrides = read_json(config)?;
+    }
     experiment.force = args.force;
     experiment.out = args.out;
     report(&experiment.run()?, &experiment.out);
@@ -115,6 +130,9 @@ fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     }
     if let Some(config) = &args.config {
         experiment.overrides = read_json(config)?;
+    }
+    if let Some(config) = &args.cnn_config {
+        experiment.cnn_overrides = read_json(config)?;
     }
     if args.test_problems.is_some() {
         experiment.test_problems = args.test_problems;

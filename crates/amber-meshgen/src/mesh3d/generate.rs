@@ -104,14 +104,31 @@ impl From<Mesh3dError> for crate::MeshgenError {
 
 /// Meshes the solid bounded by `reference` with tets whose sizes follow `field` (target edge
 /// lengths, spec §0): [`adapt_surface`], then [`fill_surface`]. Deterministic: the same
-/// inputs give the same mesh.
+/// inputs give the same mesh. A remeshed surface that TetGen cannot fill even with its looser
+/// quality bounds (its internal error) is remeshed again at slightly smaller sizes, which moves
+/// every surface vertex, and filled again.
 pub fn generate_3d(
     reference: &Surface,
     field: &impl SizingField<3>,
     params: &Mesh3dParams,
 ) -> Result<Mesh3, Mesh3dError> {
-    fill_surface(&adapt_surface(reference, field, params)?, field, params)
+    let mut out = fill_surface(&adapt_surface(reference, field, params)?, field, params);
+    for shrink in SURFACE_RETRY_SHRINK {
+        match out {
+            Err(Mesh3dError::Tetgen(TetgenError::Internal)) => {
+                let params = Mesh3dParams { size_factor: params.size_factor * shrink, ..*params };
+                out = fill_surface(&adapt_surface(reference, field, &params)?, field, &params);
+            }
+            _ => break,
+        }
+    }
+    out
 }
+
+/// Factors on the field for the surface remeshed again when TetGen fails on the first one
+/// (a validation rollout of an early Console model: 1 of 10 steps hit TetGen's internal error
+/// with all three quality bounds).
+const SURFACE_RETRY_SHRINK: [f64; 2] = [0.97, 0.94];
 
 /// The first stage of [`generate_3d`]: validates `reference` unless it has been (closed,
 /// manifold, oriented, no self-intersections) and remeshes it to `field` capped by curvature
