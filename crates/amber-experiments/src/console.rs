@@ -90,8 +90,8 @@ impl ConsoleExperiment {
                     config.network.latent_dim = 128;
                 }
                 if self.profile == Profile::Quick {
-                    // A batch is at least one whole part (3k–40k elements), and D = 128 trains at
-                    // ~7.5k nodes/s here: 800 steps take about 27 minutes.
+                    // A batch is at least one whole part (1.4k–42k elements), and D = 128 trains at
+                    // ~7.5k nodes/s here: 800 steps took 16–20 minutes (docs/PROFILES.md).
                     config.steps = 800;
                     config.validation_interval = 400;
                 }
@@ -109,8 +109,8 @@ impl ConsoleExperiment {
                 let mut config = CnnConfig::profile(self.profile);
                 config.resolution = resolution;
                 if self.profile == Profile::Quick {
-                    // A 32³ step of 4 images takes ~1.9 s here, a 64³ image ~2.9 s: about 10 and
-                    // 15 minutes of training.
+                    // A 32³ step of 4 images took 1.9 s here, a 64³ step of 3 images 8.2 s: 9 and
+                    // 14 minutes of training.
                     (config.steps, config.images_per_step) =
                         if resolution <= 32 { (300, Some(4)) } else { (100, Some(3)) };
                 }

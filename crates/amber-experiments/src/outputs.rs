@@ -51,7 +51,7 @@ pub(crate) fn write_outputs(
         .collect();
     bar_chart(
         &out.join("ndcd_bars.png"),
-        &format!("{}: normalised DCD on the test problems", results.experiment),
+        &format!("{}: normalised DCD on {}", results.experiment, results.evaluated_on()),
         "normalised DCD",
         &groups,
     )?;
@@ -69,9 +69,11 @@ pub(crate) fn write_outputs(
                 Some(Series { label: spec.label(), points })
             })
             .collect();
+        // A task with a single setting (Console) is named once.
+        let title = if s.name == results.experiment { s.name.clone() } else { format!("{} {}", results.experiment, s.name) };
         line_chart(
             &out.join(format!("ndcd_per_step_{}.png", s.name)),
-            &format!("{} {}: normalised DCD per generation step (step 0 = M⁰)", results.experiment, s.name),
+            &format!("{title}: normalised DCD per generation step (step 0 = M⁰)"),
             "generation step",
             "normalised DCD",
             &series,

@@ -152,6 +152,17 @@ pub struct ExperimentResults {
     pub runs: Vec<RunResult>,
 }
 
+impl ExperimentResults {
+    /// The problems the runs were evaluated on, for captions: the test problems, or the split a
+    /// task without a test split fell back to (`config.test_split`).
+    pub fn evaluated_on(&self) -> String {
+        match self.config["test_split"].as_str() {
+            Some(split) if split != "test" => format!("the {split} problems (no test split)"),
+            _ => "the test problems".into(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -186,5 +197,20 @@ mod tests {
         assert!((run.ndcd_quantiles[0] - 0.25).abs() < 1e-12 && (run.ndcd_quantiles[1] - 0.35).abs() < 1e-12);
         assert_eq!(run.failed_steps, 1);
         assert_eq!((run.test_problems, run.expert_elements), (3, 20.0));
+    }
+
+    #[test]
+    fn captions_name_the_split_that_was_evaluated() {
+        let results = |config| ExperimentResults {
+            experiment: "console".into(),
+            profile: "quick".into(),
+            commit: None,
+            machine: serde_json::json!({}),
+            config,
+            runs: Vec::new(),
+        };
+        assert_eq!(results(serde_json::json!({ "test_split": "val" })).evaluated_on(), "the val problems (no test split)");
+        assert_eq!(results(serde_json::json!({ "test_split": "test" })).evaluated_on(), "the test problems");
+        assert_eq!(results(serde_json::json!({})).evaluated_on(), "the test problems");
     }
 }

@@ -48,11 +48,13 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
     let seeds = results.runs.iter().map(|r| r.seed).max().map_or(0, |s| s + 1);
     let _ = writeln!(
         md,
-        "# {} — profile `{}`\n\nNormalised DCD after the last generation step on the test problems (lower is better; \
+        "# {} — profile `{}`\n\nNormalised DCD after the last generation step on {} (lower is better; \
          0 = as good as re-meshing with the expert's own sizing field, 1 = no better than M⁰): mean over problems \
          [25 %, 75 % quantiles], averaged over {seeds} seed(s). *Paper* is the paper's number (mean of 4 seeds) where \
          it gives one.\n",
-        results.experiment, results.profile
+        results.experiment,
+        results.profile,
+        results.evaluated_on()
     );
     if results.config["experiment"]["scale_to_budget"] == true {
         md.push_str(
@@ -96,7 +98,7 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
     }
     let _ = writeln!(
         md,
-        "\n## Raw numbers\n\nMeans over test problems and seeds: raw DCD of the final mesh d(Mᵀ), of M⁰ and of the \
+        "\n## Raw numbers\n\nMeans over the evaluated problems and seeds: raw DCD of the final mesh d(Mᵀ), of M⁰ and of the \
          reconstruction M̂ to the expert; normalised DCD per generation step; elements (expert); failed or \
          over-budget generation steps (summed); training and evaluation wall time.\n"
     );
