@@ -37,12 +37,8 @@ struct ConsoleArgs {
     /// Methods, comma-separated (default: the profile's).
     #[arg(long, value_delimiter = ',')]
     methods: Vec<Method>,
-    /// A JSON file of training-config fields overriding the profile's for every AMBER run.
-    #[arg(long)]
-    config: Option<PathBuf>,
-    /// A JSON file of config fields overriding the profile's for every CNN run.
-    #[arg(long)]
-    cnn_config: Option<PathBuf>,
+    #[command(flatten)]
+    overrides: OverrideArgs,
     /// Retrain and re-evaluate even when cached.
     #[arg(long)]
     force: bool,
@@ -72,12 +68,8 @@ struct PoissonArgs {
     /// Evaluate on the first N test problems only.
     #[arg(long)]
     test_problems: Option<usize>,
-    /// A JSON file of training-config fields overriding the profile's for every AMBER run.
-    #[arg(long)]
-    config: Option<PathBuf>,
-    /// A JSON file of config fields overriding the profile's for every CNN run.
-    #[arg(long)]
-    cnn_config: Option<PathBuf>,
+    #[command(flatten)]
+    overrides: OverrideArgs,
     /// Skip a generation step whose field exceeds the element budget, as the paper does,
     /// instead of scaling the field to the budget (the default outside the paper profile).
     #[arg(long)]
@@ -88,6 +80,25 @@ struct PoissonArgs {
     /// Output directory.
     #[arg(long, default_value = "results/poisson")]
     out: PathBuf,
+}
+
+/// Config overrides from JSON files, shared by the experiments.
+#[derive(clap::Args, Debug)]
+struct OverrideArgs {
+    /// A JSON file of training-config fields overriding the profile's for every AMBER run.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// A JSON file of config fields overriding the profile's for every CNN run.
+    #[arg(long)]
+    cnn_config: Option<PathBuf>,
+}
+
+impl OverrideArgs {
+    /// The AMBER and CNN overrides (empty objects where no file is given).
+    fn read(&self) -> anyhow::Result<(serde_json::Value, serde_json::Value)> {
+        let read = |path: &Option<PathBuf>| path.as_deref().map_or(Ok(serde_json::json!({})), read_json);
+        Ok((read(&self.config)?, read(&self.cnn_config)?))
+    }
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -105,12 +116,7 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
     if !args.methods.is_empty() {
         experiment.methods = args.methods.into_iter().map(MethodSpec::plain).collect();
     }
-    if let Some(config) = &args.config {
-        experiment.overrides = read_json(config)?;
-    }
-    if let Some(config) = &args.cnn_config {
-        experiment.cnn_overrides = read_json(config)?;
-    }
+    (experiment.overrides, experiment.cnn_overrides) = args.overrides.read()?;
     experiment.force = args.force;
     experiment.out = args.out;
     report(&experiment.run()?, &experiment.out);
@@ -128,12 +134,7 @@ fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     if !args.methods.is_empty() {
         experiment.methods = args.methods.into_iter().map(MethodSpec::plain).collect();
     }
-    if let Some(config) = &args.config {
-        experiment.overrides = read_json(config)?;
-    }
-    if let Some(config) = &args.cnn_config {
-        experiment.cnn_overrides = read_json(config)?;
-    }
+    (experiment.overrides, experiment.cnn_overrides) = args.overrides.read()?;
     if args.test_problems.is_some() {
         experiment.test_problems = args.test_problems;
     }

@@ -10,14 +10,14 @@ use amber_tasks::console::{
     ConsoleProblem, ConsoleSplit, INITIAL_MESH_RECIPE, TrainSet, has_test_split, part_names,
 };
 use amber_train::{CnnConfig, Profile, TrainingConfig};
-use anyhow::{Context, bail};
+use anyhow::bail;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
-use crate::report::{commit, machine, merge_json};
+use crate::report::{commit, machine};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 
@@ -79,10 +79,6 @@ impl ConsoleExperiment {
     /// latent width 128, h_min at the 0.5 % quantile of the training experts' sizes), the
     /// method's labels, the overrides and the seed.
     pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<RunConfig> {
-        let patch = |value: &mut serde_json::Value, overrides: &serde_json::Value| {
-            merge_json(value, overrides);
-            merge_json(value, &spec.variant.overrides);
-        };
         Ok(match spec.method {
             Method::AmberMean | Method::AmberMax => {
                 let mut config = TrainingConfig::profile(self.profile);
@@ -98,10 +94,7 @@ impl ConsoleExperiment {
                 config.min_size_quantile = 0.005;
                 config.aggregation = spec.method.aggregation();
                 config.seed = seed as u64;
-                let mut value = serde_json::to_value(&config)?;
-                patch(&mut value, &self.overrides);
-                let config: TrainingConfig = serde_json::from_value(value)
-                    .with_context(|| format!("the overrides of {} do not fit its configuration", spec.label()))?;
+                let config = spec.patched(&config, &self.overrides)?;
                 config.validate()?;
                 RunConfig::Amber(config)
             }
@@ -117,10 +110,7 @@ impl ConsoleExperiment {
                 config.min_size_quantile = 0.005;
                 config.aggregation = spec.method.aggregation();
                 config.seed = seed as u64;
-                let mut value = serde_json::to_value(&config)?;
-                patch(&mut value, &self.cnn_overrides);
-                let config: CnnConfig = serde_json::from_value(value)
-                    .with_context(|| format!("the overrides of {} do not fit its configuration", spec.label()))?;
+                let config = spec.patched(&config, &self.cnn_overrides)?;
                 config.validate()?;
                 RunConfig::Cnn(config)
             }

@@ -5,7 +5,11 @@ use std::fmt;
 use std::str::FromStr;
 
 use amber_graph::Aggregation;
+use anyhow::Context;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+
+use crate::report::merge_json;
 
 /// A meshing method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -114,6 +118,19 @@ impl MethodSpec {
             "default" => self.method.name(),
             variant => format!("{} ({variant})", self.method.name()),
         }
+    }
+
+    /// `base` (a run's config) with the user's `overrides` and then this variant's merged in.
+    pub(crate) fn patched<T: Serialize + DeserializeOwned>(
+        &self,
+        base: &T,
+        overrides: &serde_json::Value,
+    ) -> anyhow::Result<T> {
+        let mut value = serde_json::to_value(base)?;
+        merge_json(&mut value, overrides);
+        merge_json(&mut value, &self.variant.overrides);
+        serde_json::from_value(value)
+            .with_context(|| format!("the overrides of {} do not fit its configuration", self.label()))
     }
 }
 

@@ -7,14 +7,14 @@ use std::path::{Path, PathBuf};
 use amber_mesh::Mesh2;
 use amber_tasks::poisson::{Difficulty, PoissonProblem, Split, load_split, read_split};
 use amber_train::{CnnConfig, Profile, TrainingConfig};
-use anyhow::{Context, bail};
+use anyhow::bail;
 use serde::Serialize;
 
 use crate::method::{Method, MethodSpec, Variant};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::progress::item_bar;
-use crate::report::{commit, machine, merge_json, read_json};
+use crate::report::{commit, machine, read_json};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 
@@ -135,23 +135,13 @@ impl PoissonExperiment {
     /// the user's overrides (AMBER runs: `overrides`, CNN runs: `cnn_overrides`), the difficulty
     /// and the seed.
     pub fn run_config(&self, spec: &MethodSpec, difficulty: Difficulty, seed: usize) -> anyhow::Result<RunConfig> {
-        fn patched<T: Serialize + serde::de::DeserializeOwned>(
-            base: &T,
-            overrides: [&serde_json::Value; 2],
-            spec: &MethodSpec,
-        ) -> anyhow::Result<T> {
-            let mut value = serde_json::to_value(base)?;
-            overrides.iter().for_each(|o| merge_json(&mut value, o));
-            serde_json::from_value(value)
-                .with_context(|| format!("the overrides of {} do not fit its configuration", spec.label()))
-        }
         Ok(match spec.method {
             Method::AmberMean | Method::AmberMax => {
                 let mut config = TrainingConfig::profile(self.profile);
                 config.aggregation = spec.method.aggregation();
                 config.data.difficulty = difficulty;
                 config.seed = seed as u64;
-                let config = patched(&config, [&self.overrides, &spec.variant.overrides], spec)?;
+                let config = spec.patched(&config, &self.overrides)?;
                 config.validate()?;
                 RunConfig::Amber(config)
             }
@@ -161,7 +151,7 @@ impl PoissonExperiment {
                 config.aggregation = spec.method.aggregation();
                 config.data.difficulty = difficulty;
                 config.seed = seed as u64;
-                let config = patched(&config, [&self.cnn_overrides, &spec.variant.overrides], spec)?;
+                let config = spec.patched(&config, &self.cnn_overrides)?;
                 config.validate()?;
                 RunConfig::Cnn(config)
             }
