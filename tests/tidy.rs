@@ -56,6 +56,7 @@ fn no_ignored_or_should_panic_tests() {
 const ALLOWED: &[(&str, &[&str])] = &[
     ("tetgen-sys", &[]),
     ("amber-mesh", &[]),
+    ("amber-testdata", &[]),
     ("amber-meshgen", &["amber-mesh", "tetgen-sys"]),
     ("amber-fem", &["amber-mesh", "amber-meshgen"]),
     ("amber-graph", &["amber-mesh"]),

@@ -124,20 +124,9 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     assert!(experiment.out.join("ndcd_bars.png").exists());
 }
 
-/// The shipped Console data, or `None` (with a message) when it is absent.
-fn console_data() -> Option<std::path::PathBuf> {
-    let candidates =
-        [Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"), "/work/shared/data/console".into()];
-    let found = candidates.into_iter().find(|p| p.join("train").is_dir());
-    if found.is_none() {
-        println!("skipping: the Console data (../shared/data/console) is not present");
-    }
-    found
-}
-
 #[test]
 fn console_smoke_trains_evaluates_on_val_and_draws_surfaces() {
-    let Some(data) = console_data() else { return };
+    let Some(data) = amber_testdata::shared("data/console") else { return };
     let dir = tempfile::tempdir().unwrap();
     let mut experiment = amber_experiments::ConsoleExperiment::new(Profile::Smoke, &data);
     experiment.runs_root = dir.path().join("data/runs");

@@ -192,11 +192,8 @@ mod tests {
     /// Every fixture in `fixtures/dcd` (independent scipy values) must match to 1e-9.
     #[test]
     fn matches_reference_fixtures() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/fixtures/dcd");
-        let Ok(entries) = std::fs::read_dir(&dir) else {
-            println!("skipping: DCD fixtures not found at {}", dir.display());
-            return;
-        };
+        let Some(dir) = amber_testdata::shared("fixtures/dcd") else { return };
+        let entries = std::fs::read_dir(&dir).unwrap();
         let mut checked = 0;
         for path in entries.map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "json")) {
             let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();

@@ -38,33 +38,18 @@ impl Problem<3> for ConsoleProblem {
 
 #[cfg(test)]
 mod tests {
-    use std::path::{Path, PathBuf};
-
     use amber_graph::Aggregation;
     use amber_tasks::console::ConsoleSplit;
 
     use super::*;
     use crate::task::{MeshLimits, MeshState, StepOutcome, generation_step, labels};
 
-    /// The shipped data bundle, or `None` (with a message) when it is absent.
-    fn shipped_data() -> Option<PathBuf> {
-        let candidates = [
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"),
-            "/work/shared/data/console".into(),
-        ];
-        let found = candidates.into_iter().find(|p| p.join("train").is_dir());
-        if found.is_none() {
-            println!("skipping: the Console data (../shared/data/console) is not present");
-        }
-        found
-    }
-
     /// One generation step on val/002 from M⁰ with a smoke-size field (3 mm everywhere): a new
     /// mesh of the same solid with about the expected element count, its graph and labels; and a
     /// field far too fine is stopped by the budget, not meshed.
     #[test]
     fn one_generation_step_on_a_shipped_part() {
-        let Some(data) = shipped_data() else { return };
+        let Some(data) = amber_testdata::shared("data/console") else { return };
         let problem = ConsoleProblem::load(&data, ConsoleSplit::Val, "002").unwrap();
         let m0 = problem.initial_mesh();
         let limits = MeshLimits::from_experts([problem.expert_mesh()], 1.2, 0.005);

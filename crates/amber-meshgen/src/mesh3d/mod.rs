@@ -23,14 +23,8 @@ pub use tetgen::{
 /// The shipped Console reference surfaces (19 train + 2 val), or `None` when the data is absent.
 #[cfg(test)]
 fn console_reference_surfaces() -> Option<Vec<std::path::PathBuf>> {
-    use std::path::{Path, PathBuf};
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console/reference_surface");
-    let root = if root.is_dir() { root } else { Path::new("/work/shared/data/console/reference_surface").to_owned() };
-    if !root.is_dir() {
-        println!("skipping: {} not found", root.display());
-        return None;
-    }
-    let mut files: Vec<PathBuf> = ["train", "val"]
+    let root = amber_testdata::shared("data/console/reference_surface")?;
+    let mut files: Vec<std::path::PathBuf> = ["train", "val"]
         .iter()
         .filter_map(|split| std::fs::read_dir(root.join(split)).ok())
         .flatten()

@@ -183,19 +183,6 @@ pub fn load_split(data: &Path, split: ConsoleSplit, train_set: TrainSet) -> Resu
 mod tests {
     use super::*;
 
-    /// The shipped data bundle, or `None` (with a message) when it is absent.
-    fn shipped_data() -> Option<PathBuf> {
-        let candidates = [
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/console"),
-            "/work/shared/data/console".into(),
-        ];
-        let found = candidates.into_iter().find(|p| p.join("train").is_dir());
-        if found.is_none() {
-            println!("skipping: the Console data (../shared/data/console) is not present");
-        }
-        found
-    }
-
     #[test]
     fn initial_size_is_the_regular_tet_of_ten_cubic_millimetres() {
         assert!((amber_mesh::size_from_volume::<3>(INITIAL_ELEMENT_VOLUME) - INITIAL_SIZE).abs() < 2e-3);
@@ -213,7 +200,7 @@ mod tests {
 
     #[test]
     fn shipped_splits_follow_the_paper() {
-        let Some(data) = shipped_data() else { return };
+        let Some(data) = amber_testdata::shared("data/console") else { return };
         let train = part_names(&data, ConsoleSplit::Train, TrainSet::Paper).unwrap();
         assert_eq!(train.len(), 15);
         assert_eq!((train[0].as_str(), train[14].as_str()), ("001", "015"));
@@ -229,7 +216,7 @@ mod tests {
 
     #[test]
     fn shipped_part_loads_with_a_uniform_initial_mesh() {
-        let Some(data) = shipped_data() else { return };
+        let Some(data) = amber_testdata::shared("data/console") else { return };
         let start = std::time::Instant::now();
         let problem = ConsoleProblem::load(&data, ConsoleSplit::Val, "002").unwrap();
         let (m0, expert) = (&problem.initial_mesh, &problem.expert_mesh);
@@ -251,7 +238,7 @@ mod tests {
 
     #[test]
     fn a_missing_reference_surface_says_how_to_make_it() {
-        let Some(data) = shipped_data() else { return };
+        let Some(data) = amber_testdata::shared("data/console") else { return };
         let dir = std::env::temp_dir().join(format!("amber-console-test-{}", std::process::id()));
         std::fs::create_dir_all(dir.join("val")).unwrap();
         std::fs::copy(data.join("val/002.nas"), dir.join("val/002.nas")).unwrap();

@@ -1,0 +1,26 @@
+//! Where the tests find the shared data and fixtures (`../shared/` beside the workspace: the
+//! Console bundle, the independently computed reference values), and the one message a test
+//! prints when it skips because they are absent. `$AMBER_SHARED` points elsewhere, e.g. from a
+//! checkout that does not sit next to `shared/`. A dev-dependency only: no shipped code reads
+//! data from a fixed place.
+
+use std::path::{Path, PathBuf};
+
+/// The shared folder: `$AMBER_SHARED`, else `shared/` beside the workspace.
+fn shared_root() -> PathBuf {
+    std::env::var_os("AMBER_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared"))
+}
+
+/// `relative` (e.g. `data/console`) under the shared folder, or `None` after printing why the
+/// calling test skips.
+pub fn shared(relative: &str) -> Option<PathBuf> {
+    let path = shared_root().join(relative);
+    if path.exists() {
+        Some(path)
+    } else {
+        println!("skipping: {} is absent (set AMBER_SHARED to the folder holding data/ and fixtures/)", path.display());
+        None
+    }
+}
