@@ -50,9 +50,11 @@ fn plot_error(e: impl std::fmt::Display) -> anyhow::Error {
 /// mean written above each bar.
 pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec<Bar>)]) -> anyhow::Result<()> {
     register_default_font();
-    // Wide enough for every bar's label.
+    // Wide enough for every bar's label (~7 px per character at the label font).
     let bars_total: usize = groups.iter().map(|(_, bars)| bars.len()).sum();
-    let width = WIDTH.max(130 * bars_total as u32 + 90 * groups.len() as u32);
+    let longest_label = groups.iter().flat_map(|(_, bars)| bars.iter().map(|b| b.label.chars().count())).max();
+    let bar_width = 130.max(7 * longest_label.unwrap_or(0) as u32 + 16);
+    let width = WIDTH.max(bar_width * bars_total as u32 + 90 * groups.len() as u32);
     let mut rgb = vec![255u8; 3 * (width * HEIGHT) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (width, HEIGHT)).into_drawing_area();
@@ -80,6 +82,8 @@ pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec
                 .disable_x_mesh()
                 .y_desc(y_label)
                 .label_style((FONT, 13))
+                // One label per bar: plotters draws at most ten by default.
+                .x_labels(bars.len())
                 .x_label_formatter(&|v| match v {
                     SegmentValue::CenterOf(i) => names.get(*i as usize).cloned().unwrap_or_default(),
                     _ => String::new(),
