@@ -7,11 +7,10 @@
 
 use std::sync::Arc;
 
-use candle_core::backend::BackendStorage;
-use candle_core::{CpuStorage, CustomOp3, Layout, Result, Shape, Tensor, bail};
+use candle_core::{Result, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Saved, SavedSlot, Scratch, cpu_slice, float_dtype, tensor_of, tensor_slice};
+use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch, tensor_of, tensor_slice};
 use crate::graph::Topology;
 use crate::kernels::{
     BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, add_assign, add_gathered, matmul,
@@ -33,7 +32,7 @@ pub(crate) fn edge_update(
         save: x.track_op() || e.track_op() || theta.track_op(),
         saved: SavedSlot::default(),
     };
-    x.apply_op3(&e, &theta, op)
+    x.apply_op3(&e, &theta, Fused(op))
 }
 
 struct EdgeUpdate {
@@ -52,6 +51,15 @@ impl EdgeUpdate {
             );
         }
         Ok(())
+    }
+
+}
+
+impl FusedMlpOp for EdgeUpdate {
+    const NAME: &'static str = "amber-edge-update";
+
+    fn output_shape(&self) -> (usize, usize) {
+        (self.topology.num_edges(), self.d)
     }
 
     fn forward<T: Real>(&self, x: &[T], e: &[T], theta: &[T]) -> Result<Vec<T>> {
@@ -155,7 +163,7 @@ impl EdgeUpdate {
             tensor_slice::<T>(&gs, gl)?,
         );
         self.check(xv.len(), ev.len(), tv.len())?;
-        let saved = self.saved.take(self.name())?;
+        let saved = self.saved.take(Self::NAME)?;
         // The backward overwrites the saved activations with gradients: h1 becomes d(first-layer
         // pre-activation), h2 becomes d(e), saving two edge-sized allocations.
         let (mut dpre1, mut de) = (
@@ -274,55 +282,6 @@ impl EdgeUpdate {
             tensor_of(de, (m, d), e)?,
             Tensor::from_vec(g.pack(3 * d, d), theta.shape(), theta.device())?,
         ])
-    }
-}
-
-impl CustomOp3 for EdgeUpdate {
-    fn name(&self) -> &'static str {
-        "amber-edge-update"
-    }
-
-    fn cpu_fwd(
-        &self,
-        s1: &CpuStorage,
-        l1: &Layout,
-        s2: &CpuStorage,
-        l2: &Layout,
-        s3: &CpuStorage,
-        l3: &Layout,
-    ) -> Result<(CpuStorage, Shape)> {
-        let shape = Shape::from((self.topology.num_edges(), self.d));
-        let storage = match float_dtype(self.name(), &[s1.dtype(), s2.dtype(), s3.dtype()])? {
-            candle_core::DType::F32 => CpuStorage::F32(self.forward::<f32>(
-                cpu_slice(s1, l1)?,
-                cpu_slice(s2, l2)?,
-                cpu_slice(s3, l3)?,
-            )?),
-            _ => CpuStorage::F64(self.forward::<f64>(
-                cpu_slice(s1, l1)?,
-                cpu_slice(s2, l2)?,
-                cpu_slice(s3, l3)?,
-            )?),
-        };
-        Ok((storage, shape))
-    }
-
-    fn bwd(
-        &self,
-        x: &Tensor,
-        e: &Tensor,
-        theta: &Tensor,
-        _res: &Tensor,
-        grad: &Tensor,
-    ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-        let [dx, de, dtheta] = match float_dtype(
-            self.name(),
-            &[x.dtype(), e.dtype(), theta.dtype(), grad.dtype()],
-        )? {
-            candle_core::DType::F32 => self.backward::<f32>(x, e, theta, grad)?,
-            _ => self.backward::<f64>(x, e, theta, grad)?,
-        };
-        Ok((Some(dx), Some(de), Some(dtheta)))
     }
 }
 

@@ -13,7 +13,8 @@ mod tanh;
 
 use std::sync::Mutex;
 
-use candle_core::{CpuStorage, DType, Layout, Result, Storage, Tensor, bail};
+use candle_core::backend::BackendStorage;
+use candle_core::{CpuStorage, CustomOp3, DType, Layout, Result, Shape, Storage, Tensor, bail};
 
 pub(crate) use edge_update::edge_update;
 pub(crate) use node_update::node_update;
@@ -51,6 +52,56 @@ fn float_dtype(op: &str, dtypes: &[DType]) -> Result<DType> {
 
 fn tensor_of<T: Real>(data: Vec<T>, shape: (usize, usize), like: &Tensor) -> Result<Tensor> {
     Tensor::from_vec(data, shape, like.device())
+}
+
+/// A fused residual-MLP op of three inputs (states, second states, packed parameters) with a
+/// hand-written backward, in f32 or f64; [`Fused`] makes it a candle op.
+trait FusedMlpOp: Send + Sync {
+    const NAME: &'static str;
+    /// Rows and columns of the output.
+    fn output_shape(&self) -> (usize, usize);
+    fn forward<T: Real>(&self, a: &[T], b: &[T], theta: &[T]) -> Result<Vec<T>>;
+    fn backward<T: Real>(&self, a: &Tensor, b: &Tensor, theta: &Tensor, grad: &Tensor) -> Result<[Tensor; 3]>;
+}
+
+/// The candle `CustomOp3` of a [`FusedMlpOp`]: dtype dispatch and storage access in one place.
+struct Fused<Op>(Op);
+
+impl<Op: FusedMlpOp> CustomOp3 for Fused<Op> {
+    fn name(&self) -> &'static str {
+        Op::NAME
+    }
+
+    fn cpu_fwd(
+        &self,
+        s1: &CpuStorage,
+        l1: &Layout,
+        s2: &CpuStorage,
+        l2: &Layout,
+        s3: &CpuStorage,
+        l3: &Layout,
+    ) -> Result<(CpuStorage, Shape)> {
+        let storage = match float_dtype(Op::NAME, &[s1.dtype(), s2.dtype(), s3.dtype()])? {
+            DType::F32 => CpuStorage::F32(self.0.forward::<f32>(cpu_slice(s1, l1)?, cpu_slice(s2, l2)?, cpu_slice(s3, l3)?)?),
+            _ => CpuStorage::F64(self.0.forward::<f64>(cpu_slice(s1, l1)?, cpu_slice(s2, l2)?, cpu_slice(s3, l3)?)?),
+        };
+        Ok((storage, Shape::from(self.0.output_shape())))
+    }
+
+    fn bwd(
+        &self,
+        a: &Tensor,
+        b: &Tensor,
+        theta: &Tensor,
+        _res: &Tensor,
+        grad: &Tensor,
+    ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let [da, db, dtheta] = match float_dtype(Op::NAME, &[a.dtype(), b.dtype(), theta.dtype(), grad.dtype()])? {
+            DType::F32 => self.0.backward::<f32>(a, b, theta, grad)?,
+            _ => self.0.backward::<f64>(a, b, theta, grad)?,
+        };
+        Ok((Some(da), Some(db), Some(dtheta)))
+    }
 }
 
 /// First-layer activations, second-layer activations and LayerNorm statistics of a residual MLP

@@ -1,11 +1,10 @@
 //! The update function: `x ← LayerNorm(x + MLP_V([x, a]))` as one op, with the concatenation
 //! split into `x·W_x + a·W_a`.
 
-use candle_core::backend::BackendStorage;
-use candle_core::{CpuStorage, CustomOp3, Layout, Result, Shape, Tensor, bail};
+use candle_core::{Result, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Saved, SavedSlot, Scratch, cpu_slice, float_dtype, tensor_of, tensor_slice};
+use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch, tensor_of, tensor_slice};
 use crate::kernels::{
     BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, matmul, packed_len, tail_backward,
     tail_forward,
@@ -21,7 +20,7 @@ pub(crate) fn node_update(x: &Tensor, a: &Tensor, theta: &Tensor) -> Result<Tens
         save: x.track_op() || a.track_op() || theta.track_op(),
         saved: SavedSlot::default(),
     };
-    x.apply_op3(&a, &theta, op)
+    x.apply_op3(&a, &theta, Fused(op))
 }
 
 struct NodeUpdate {
@@ -40,6 +39,15 @@ impl NodeUpdate {
             );
         }
         Ok(())
+    }
+
+}
+
+impl FusedMlpOp for NodeUpdate {
+    const NAME: &'static str = "amber-node-update";
+
+    fn output_shape(&self) -> (usize, usize) {
+        (self.rows, self.d)
     }
 
     fn forward<T: Real>(&self, x: &[T], a: &[T], theta: &[T]) -> Result<Vec<T>> {
@@ -125,7 +133,7 @@ impl NodeUpdate {
             tensor_slice::<T>(&gs, gl)?,
         );
         self.check(xv.len(), av.len(), tv.len())?;
-        let saved = self.saved.take(self.name())?;
+        let saved = self.saved.take(Self::NAME)?;
         // As in the edge update, the saved activations are overwritten with gradients: h2 becomes
         // d(x), h1 the first-layer pre-activation gradient.
         let (mut h1, mut dx) = (
@@ -192,55 +200,6 @@ impl NodeUpdate {
             tensor_of(da, (n, d), a)?,
             Tensor::from_vec(g.pack(2 * d, d), theta.shape(), theta.device())?,
         ])
-    }
-}
-
-impl CustomOp3 for NodeUpdate {
-    fn name(&self) -> &'static str {
-        "amber-node-update"
-    }
-
-    fn cpu_fwd(
-        &self,
-        s1: &CpuStorage,
-        l1: &Layout,
-        s2: &CpuStorage,
-        l2: &Layout,
-        s3: &CpuStorage,
-        l3: &Layout,
-    ) -> Result<(CpuStorage, Shape)> {
-        let shape = Shape::from((self.rows, self.d));
-        let storage = match float_dtype(self.name(), &[s1.dtype(), s2.dtype(), s3.dtype()])? {
-            candle_core::DType::F32 => CpuStorage::F32(self.forward::<f32>(
-                cpu_slice(s1, l1)?,
-                cpu_slice(s2, l2)?,
-                cpu_slice(s3, l3)?,
-            )?),
-            _ => CpuStorage::F64(self.forward::<f64>(
-                cpu_slice(s1, l1)?,
-                cpu_slice(s2, l2)?,
-                cpu_slice(s3, l3)?,
-            )?),
-        };
-        Ok((storage, shape))
-    }
-
-    fn bwd(
-        &self,
-        x: &Tensor,
-        a: &Tensor,
-        theta: &Tensor,
-        _res: &Tensor,
-        grad: &Tensor,
-    ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-        let [dx, da, dtheta] = match float_dtype(
-            self.name(),
-            &[x.dtype(), a.dtype(), theta.dtype(), grad.dtype()],
-        )? {
-            candle_core::DType::F32 => self.backward::<f32>(x, a, theta, grad)?,
-            _ => self.backward::<f64>(x, a, theta, grad)?,
-        };
-        Ok((Some(dx), Some(da), Some(dtheta)))
     }
 }
 
