@@ -127,6 +127,11 @@ pub struct TrainingConfig {
     /// Append log h(K) to the task's node features (see [`crate::with_log_size`]); not in the
     /// paper.
     pub log_size_feature: bool,
+    /// Append the log-scaled load to the node features (see [`crate::with_log_load`]; Poisson
+    /// only); not in the paper. Left out of the serialised config when off, so the configs (and
+    /// cache keys) of runs without it are unchanged.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub log_load_feature: bool,
     /// The network.
     pub network: NetworkConfig,
     /// Gradient steps.
@@ -180,6 +185,7 @@ impl TrainingConfig {
             normalise_labels: false,
             normalise_inputs: true,
             log_size_feature: false,
+            log_load_feature: false,
             network: NetworkConfig::default(),
             steps: 128_000,
             learning_rate: 3e-4,

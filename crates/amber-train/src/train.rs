@@ -23,7 +23,7 @@ use crate::model::{WEIGHTS_FILE, read_json, write_json};
 use crate::optim::Adam;
 use crate::{
     AmberModel, Evaluation, EvaluationSummary, MeshLimits, MeshState, Predictor, Problem, ProblemError, ReplayBuffer,
-    Sample, StepOutcome, TargetTransform, TrainingConfig, generation_step, labels, with_log_size,
+    Sample, StepOutcome, TargetTransform, TrainingConfig, generation_step, labels, with_log_load, with_log_size,
 };
 
 /// The final model's sub-directory of the output directory.
@@ -103,8 +103,13 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
     pub fn new(config: TrainingConfig, problems: Vec<P>) -> Result<Self> {
         config.validate()?;
         let first = problems.first().ok_or(TrainError::NoProblems)?;
-        let features =
-            if config.log_size_feature { with_log_size(first.feature_set()) } else { first.feature_set() };
+        let mut features = first.feature_set();
+        if config.log_size_feature {
+            features = with_log_size(features);
+        }
+        if config.log_load_feature {
+            features = with_log_load(features);
+        }
         let limits = MeshLimits::from_experts(
             problems.iter().map(|p| p.expert_mesh()),
             config.budget_factor,

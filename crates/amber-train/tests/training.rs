@@ -218,3 +218,27 @@ fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
     let n = mesh.num_elements();
     assert!((1_400..=2_200).contains(&n), "{n} elements for a budget of 2,000 (aiming at 95 %)");
 }
+
+#[test]
+fn the_optional_log_features_reach_a_saved_model_that_predicts_on_new_meshes() {
+    let config = TrainingConfig { log_load_feature: true, ..tiny_config(3) };
+    let problems = problems(&[11, 12]);
+    let mut training = Training::new(config, problems.clone()).unwrap();
+    for _ in 0..3 {
+        training.train_step().unwrap();
+    }
+    let dir = tempfile::tempdir().unwrap();
+    training.save_model(dir.path()).unwrap();
+    let model = AmberModel::load(dir.path()).unwrap();
+    let names: Vec<String> = model.predictor.features.node.iter().map(|f| format!("{f:?}")).collect();
+    assert!(names.iter().any(|n| n.contains(amber_train::LOG_SIZE_COLUMN)), "{names:?}");
+    assert!(names.iter().any(|n| n.contains(amber_train::LOG_LOAD_COLUMN)), "{names:?}");
+    assert_eq!(model.network.config().node_features, 6, "the paper's 4 node features + 2");
+
+    let problem = &problems[0];
+    let state =
+        amber_train::MeshState::new(problem, &model.predictor.features, problem.expert_mesh.clone()).unwrap();
+    let sizes = model.predict(&[&state]).unwrap();
+    assert_eq!(sizes[0].len(), problem.expert_mesh.num_elements());
+    assert!(sizes[0].iter().all(|h| h.is_finite() && *h > 0.0));
+}
