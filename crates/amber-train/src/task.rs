@@ -69,8 +69,7 @@ impl Problem<2> for PoissonProblem {
     }
 
     /// Solves −Δu = f (P1) on `mesh`: `solution_mean`, `solution_std` of u over each element's
-    /// vertices, `load` = f at the element midpoint, and its log-scaled copy for the optional
-    /// feature of [`with_log_load`].
+    /// vertices, and `load` = f at the element midpoint.
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
         let order = self
             .metadata
@@ -81,13 +80,11 @@ impl Problem<2> for PoissonProblem {
         let quadrature = Quadrature::simplex::<2>(order)?;
         let solution = space.solve_poisson(&space.sample_load(&self.load, &quadrature)?)?;
         let stats = element_stats(mesh, &solution.u)?;
-        let load: Vec<f64> = mesh.midpoints().into_iter().map(|x| amber_fem::Load::value(&self.load, x)).collect();
-        let log_load = load.iter().map(|f| f.signum() * f.abs().ln_1p()).collect();
+        let load = mesh.midpoints().into_iter().map(|x| amber_fem::Load::value(&self.load, x)).collect();
         Ok(vec![
             Column { name: "solution_mean".into(), values: stats.iter().map(|s| s.mean).collect() },
             Column { name: "solution_std".into(), values: stats.iter().map(|s| s.std).collect() },
             Column { name: "load".into(), values: load },
-            Column { name: LOG_LOAD_COLUMN.into(), values: log_load },
         ])
     }
 
@@ -168,15 +165,15 @@ pub const LOG_LOAD_COLUMN: &str = "log_load";
 
 /// `features` with the log-scaled load appended: the load has peaks of 10²–10³ over a background
 /// near 0, so after linear normalisation every element off a peak looks alike, yet the expert
-/// refines well into the flanks. Only tasks with a load (Poisson) provide the column.
+/// refines well into the flanks. Derived from the task's `load` column (Poisson only).
 pub fn with_log_load(mut features: FeatureSet) -> FeatureSet {
     features.node.push(NodeFeature::Column(LOG_LOAD_COLUMN.into()));
     features
 }
 
 impl<const D: usize> MeshState<D> {
-    /// Computes the columns of `mesh` that `features` needs from `problem` (plus log h(K) if
-    /// asked for) and builds its graph.
+    /// Computes the columns of `mesh` that `features` needs from `problem` (plus log h(K) and
+    /// the log-scaled load if asked for) and builds its graph.
     pub fn new<P: Problem<D> + ?Sized>(
         problem: &P,
         features: &FeatureSet,
@@ -186,6 +183,11 @@ impl<const D: usize> MeshState<D> {
         if features.node.iter().any(|f| *f == NodeFeature::Column(LOG_SIZE_COLUMN.into())) {
             let values = mesh.sizes().into_iter().map(f64::ln).collect();
             columns.push(Column { name: LOG_SIZE_COLUMN.into(), values });
+        }
+        let log_load = features.node.iter().any(|f| *f == NodeFeature::Column(LOG_LOAD_COLUMN.into()));
+        if let Some(load) = columns.iter().find(|c| c.name == "load").filter(|_| log_load) {
+            let values = load.values.iter().map(|f| f.signum() * f.abs().ln_1p()).collect();
+            columns.push(Column { name: LOG_LOAD_COLUMN.into(), values });
         }
         Self::from_columns(features, mesh, columns)
     }
