@@ -128,8 +128,9 @@ pub struct TrainingConfig {
     /// paper.
     pub log_size_feature: bool,
     /// Append the log-scaled load to the node features (see [`crate::with_log_load`]; Poisson
-    /// only); not in the paper. Left out of the serialised config when off, so the configs (and
-    /// cache keys) of runs without it are unchanged.
+    /// only); not in the paper, and no gain at 3,000 quick steps (docs/PROFILES.md). Left out of
+    /// the serialised config when off, so the configs (and cache keys) of runs without it are
+    /// unchanged.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub log_load_feature: bool,
     /// The network.
