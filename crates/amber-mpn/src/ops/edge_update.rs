@@ -10,7 +10,7 @@ use std::sync::Arc;
 use candle_core::{Result, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch, tensor_of, tensor_slice};
+use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch};
 use crate::graph::Topology;
 use crate::kernels::{
     BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, add_assign, add_gathered, matmul,
@@ -144,24 +144,7 @@ impl FusedMlpOp for EdgeUpdate {
         Ok(out)
     }
 
-    fn backward<T: Real>(
-        &self,
-        x: &Tensor,
-        e: &Tensor,
-        theta: &Tensor,
-        grad: &Tensor,
-    ) -> Result<[Tensor; 3]> {
-        let grad = grad.contiguous()?;
-        let (xs, xl) = x.storage_and_layout();
-        let (es, el) = e.storage_and_layout();
-        let (ts, tl) = theta.storage_and_layout();
-        let (gs, gl) = grad.storage_and_layout();
-        let (xv, ev, tv, gv) = (
-            tensor_slice::<T>(&xs, xl)?,
-            tensor_slice::<T>(&es, el)?,
-            tensor_slice::<T>(&ts, tl)?,
-            tensor_slice::<T>(&gs, gl)?,
-        );
+    fn backward<T: Real>(&self, xv: &[T], ev: &[T], tv: &[T], gv: &[T]) -> Result<[Vec<T>; 3]> {
         self.check(xv.len(), ev.len(), tv.len())?;
         let saved = self.saved.take(Self::NAME)?;
         // The backward overwrites the saved activations with gradients: h1 becomes d(first-layer
@@ -277,11 +260,7 @@ impl FusedMlpOp for EdgeUpdate {
                 },
             );
         add_assign(&mut g.w1[..2 * d * d], &dw_nodes);
-        Ok([
-            tensor_of(dx, (n, d), x)?,
-            tensor_of(de, (m, d), e)?,
-            Tensor::from_vec(g.pack(3 * d, d), theta.shape(), theta.device())?,
-        ])
+        Ok([dx, de, g.pack(3 * d, d)])
     }
 }
 

@@ -61,7 +61,8 @@ trait FusedMlpOp: Send + Sync {
     /// Rows and columns of the output.
     fn output_shape(&self) -> (usize, usize);
     fn forward<T: Real>(&self, a: &[T], b: &[T], theta: &[T]) -> Result<Vec<T>>;
-    fn backward<T: Real>(&self, a: &Tensor, b: &Tensor, theta: &Tensor, grad: &Tensor) -> Result<[Tensor; 3]>;
+    /// The gradients of `a`, `b` and `theta`, each laid out as its input.
+    fn backward<T: Real>(&self, a: &[T], b: &[T], theta: &[T], grad: &[T]) -> Result<[Vec<T>; 3]>;
 }
 
 /// The candle `CustomOp3` of a [`FusedMlpOp`]: dtype dispatch and storage access in one place.
@@ -81,9 +82,10 @@ impl<Op: FusedMlpOp> CustomOp3 for Fused<Op> {
         s3: &CpuStorage,
         l3: &Layout,
     ) -> Result<(CpuStorage, Shape)> {
+        let op = &self.0;
         let storage = match float_dtype(Op::NAME, &[s1.dtype(), s2.dtype(), s3.dtype()])? {
-            DType::F32 => CpuStorage::F32(self.0.forward::<f32>(cpu_slice(s1, l1)?, cpu_slice(s2, l2)?, cpu_slice(s3, l3)?)?),
-            _ => CpuStorage::F64(self.0.forward::<f64>(cpu_slice(s1, l1)?, cpu_slice(s2, l2)?, cpu_slice(s3, l3)?)?),
+            DType::F32 => CpuStorage::F32(op.forward(cpu_slice(s1, l1)?, cpu_slice(s2, l2)?, cpu_slice(s3, l3)?)?),
+            _ => CpuStorage::F64(op.forward(cpu_slice(s1, l1)?, cpu_slice(s2, l2)?, cpu_slice(s3, l3)?)?),
         };
         Ok((storage, Shape::from(self.0.output_shape())))
     }
@@ -96,11 +98,27 @@ impl<Op: FusedMlpOp> CustomOp3 for Fused<Op> {
         _res: &Tensor,
         grad: &Tensor,
     ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let grad = grad.contiguous()?;
         let [da, db, dtheta] = match float_dtype(Op::NAME, &[a.dtype(), b.dtype(), theta.dtype(), grad.dtype()])? {
-            DType::F32 => self.0.backward::<f32>(a, b, theta, grad)?,
-            _ => self.0.backward::<f64>(a, b, theta, grad)?,
+            DType::F32 => self.backward::<f32>(a, b, theta, &grad)?,
+            _ => self.backward::<f64>(a, b, theta, &grad)?,
         };
         Ok((Some(da), Some(db), Some(dtheta)))
+    }
+}
+
+impl<Op: FusedMlpOp> Fused<Op> {
+    /// Borrows the inputs' data, runs the op's backward and shapes each gradient as its input.
+    fn backward<T: Real>(&self, a: &Tensor, b: &Tensor, theta: &Tensor, grad: &Tensor) -> Result<[Tensor; 3]> {
+        let [sa, sb, st, sg] = [a, b, theta, grad].map(|t| t.storage_and_layout());
+        let [da, db, dtheta] = self.0.backward::<T>(
+            tensor_slice(&sa.0, sa.1)?,
+            tensor_slice(&sb.0, sb.1)?,
+            tensor_slice(&st.0, st.1)?,
+            tensor_slice(&sg.0, sg.1)?,
+        )?;
+        let like = |data: Vec<T>, t: &Tensor| Tensor::from_vec(data, t.shape(), t.device());
+        Ok([like(da, a)?, like(db, b)?, like(dtheta, theta)?])
     }
 }
 

@@ -4,7 +4,7 @@
 use candle_core::{Result, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch, tensor_of, tensor_slice};
+use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch};
 use crate::kernels::{
     BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, matmul, packed_len, tail_backward,
     tail_forward,
@@ -114,24 +114,7 @@ impl FusedMlpOp for NodeUpdate {
         Ok(out)
     }
 
-    fn backward<T: Real>(
-        &self,
-        x: &Tensor,
-        a: &Tensor,
-        theta: &Tensor,
-        grad: &Tensor,
-    ) -> Result<[Tensor; 3]> {
-        let grad = grad.contiguous()?;
-        let (xs, xl) = x.storage_and_layout();
-        let (as_, al) = a.storage_and_layout();
-        let (ts, tl) = theta.storage_and_layout();
-        let (gs, gl) = grad.storage_and_layout();
-        let (xv, av, tv, gv) = (
-            tensor_slice::<T>(&xs, xl)?,
-            tensor_slice::<T>(&as_, al)?,
-            tensor_slice::<T>(&ts, tl)?,
-            tensor_slice::<T>(&gs, gl)?,
-        );
+    fn backward<T: Real>(&self, xv: &[T], av: &[T], tv: &[T], gv: &[T]) -> Result<[Vec<T>; 3]> {
         self.check(xv.len(), av.len(), tv.len())?;
         let saved = self.saved.take(Self::NAME)?;
         // As in the edge update, the saved activations are overwritten with gradients: h2 becomes
@@ -195,11 +178,7 @@ impl FusedMlpOp for NodeUpdate {
             )
             .map(|(g, _)| g)
             .reduce(|| MlpGrads::zeros(2 * d, d), MlpGrads::merge);
-        Ok([
-            tensor_of(dx, (n, d), x)?,
-            tensor_of(da, (n, d), a)?,
-            Tensor::from_vec(g.pack(2 * d, d), theta.shape(), theta.device())?,
-        ])
+        Ok([dx, da, g.pack(2 * d, d)])
     }
 }
 
