@@ -52,6 +52,9 @@ pub struct StepReport {
     pub step: u64,
     /// Loss of the batch (in the objective's training space).
     pub loss: f64,
+    /// The same loss over the batch's nodes of each buffer depth (index = depth; `None`: no
+    /// graph of that depth in the batch): where the network still errs.
+    pub loss_by_depth: Vec<Option<f64>>,
     pub learning_rate: f64,
     /// Global gradient norm before clipping.
     pub grad_norm: f64,
@@ -273,7 +276,9 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let nodes = batch.num_nodes;
         let input = GraphInput::from_batch(&batch, DType::F32, &Device::Cpu)?;
         let output = self.network.forward_train(&input, &mut self.dropout_rng)?;
-        let loss = mse(&output, &Tensor::from_vec(targets, nodes, &Device::Cpu)?)?;
+        let targets = Tensor::from_vec(targets, nodes, &Device::Cpu)?;
+        let loss_by_depth = loss_by_depth(&output, &targets, entries.iter().map(|e| (e.depth, e.sample.state.graph.num_nodes())))?;
+        let loss = mse(&output, &targets)?;
         let loss_value = f64::from(loss.to_scalar::<f32>()?);
         let grad_norm = self.optimiser.step(&loss, lr)?;
         let step_seconds = started.elapsed().as_secs_f64();
@@ -283,6 +288,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         Ok(StepReport {
             step: self.step,
             loss: loss_value,
+            loss_by_depth,
             learning_rate: lr,
             grad_norm,
             graphs: chosen.len(),
@@ -438,5 +444,40 @@ impl TrainingLog {
             serde_json::to_vec(record).map_err(|source| TrainError::Json { path: self.path.clone(), source })?;
         line.push(b'\n');
         self.file.write_all(&line).map_err(io_error(&self.path))
+    }
+}
+
+/// The mean squared error over the nodes of each depth, for a batch of graphs given in order as
+/// (depth, nodes).
+fn loss_by_depth(
+    output: &Tensor,
+    targets: &Tensor,
+    graphs: impl Iterator<Item = (usize, usize)>,
+) -> Result<Vec<Option<f64>>> {
+    let squared: Vec<f32> = (output - targets)?.sqr()?.to_vec1()?;
+    let mut sums: Vec<(f64, usize)> = Vec::new();
+    let mut start = 0;
+    for (depth, nodes) in graphs {
+        if sums.len() <= depth {
+            sums.resize(depth + 1, (0.0, 0));
+        }
+        sums[depth].0 += squared[start..start + nodes].iter().map(|&e| f64::from(e)).sum::<f64>();
+        sums[depth].1 += nodes;
+        start += nodes;
+    }
+    Ok(sums.into_iter().map(|(sum, n)| (n > 0).then(|| sum / n as f64)).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_loss_by_depth_averages_over_the_nodes_of_each_depth() {
+        let output = Tensor::new(&[1f32, 2.0, 3.0, 5.0], &Device::Cpu).unwrap();
+        let targets = Tensor::zeros(4, DType::F32, &Device::Cpu).unwrap();
+        // Graphs in batch order: depth 2 (1 node), depth 0 (2 nodes), depth 2 (1 node).
+        let by_depth = loss_by_depth(&output, &targets, [(2, 1), (0, 2), (2, 1)].into_iter()).unwrap();
+        assert_eq!(by_depth, vec![Some(6.5), None, Some(13.0)]);
     }
 }

@@ -82,9 +82,16 @@ fn training_lowers_the_loss_and_keeps_the_buffer_invariants() {
     assert!(buffer.generated().all(|e| (1..=config.max_source_depth + 1).contains(&e.depth)));
     let ids: Vec<u64> = buffer.generated().map(|e| e.id).collect();
     assert!(ids.windows(2).all(|w| w[0] < w[1]), "FIFO order {ids:?}");
-    // Every step reports the buffer it trained from.
+    // Every step reports the buffer it trained from, and its loss split by depth: the batch loss
+    // is a node-weighted mean of the per-depth losses, so it lies between them.
     let last = reports.last().unwrap();
     assert_eq!(last.buffer_depths.iter().sum::<usize>(), last.buffer_size);
+    for r in &reports {
+        let by_depth: Vec<f64> = r.loss_by_depth.iter().flatten().copied().collect();
+        let (lo, hi) = by_depth.iter().fold((f64::INFINITY, 0f64), |(lo, hi), &l| (lo.min(l), hi.max(l)));
+        assert!(lo <= r.loss * (1.0 + 1e-5) && r.loss <= hi * (1.0 + 1e-5), "step {}: {} vs {by_depth:?}", r.step, r.loss);
+    }
+    assert!(reports.iter().any(|r| r.loss_by_depth.iter().flatten().count() > 1), "batches mix depths");
 }
 
 /// Loss column of the log written by `Training::run`.
