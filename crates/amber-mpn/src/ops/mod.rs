@@ -87,7 +87,7 @@ impl<Op: FusedMlpOp> CustomOp3 for Fused<Op> {
             DType::F32 => CpuStorage::F32(op.forward(cpu_slice(s1, l1)?, cpu_slice(s2, l2)?, cpu_slice(s3, l3)?)?),
             _ => CpuStorage::F64(op.forward(cpu_slice(s1, l1)?, cpu_slice(s2, l2)?, cpu_slice(s3, l3)?)?),
         };
-        Ok((storage, Shape::from(self.0.output_shape())))
+        Ok((storage, Shape::from(op.output_shape())))
     }
 
     fn bwd(
