@@ -33,6 +33,13 @@ pub struct MpnConfig {
     /// Probability of dropping each directed edge (self-loops included) in training mode.
     pub edge_dropout: f64,
     pub output: OutputTransform,
+    /// Graph context (off in the paper): every step adds `tanh(W·mean(x) + b)`, the mean node
+    /// state of each graph transformed, to its nodes' aggregated messages. Ten steps of message
+    /// passing reach ten elements; this gives every element a view of its whole mesh (spec §11's
+    /// coarse graph level, reduced to one node per graph). Omitted from the JSON when off, so
+    /// configurations without it keep their hashes.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub graph_context: bool,
 }
 
 impl Default for MpnConfig {
@@ -52,6 +59,7 @@ impl MpnConfig {
             steps: 10,
             edge_dropout: 0.1,
             output: OutputTransform::Softplus,
+            graph_context: false,
         }
     }
 
@@ -77,11 +85,13 @@ impl MpnConfig {
     }
 
     /// Number of trainable scalars: encoders, L × (edge MLP 3D→D→D, node MLP 2D→D→D, two
-    /// affine LayerNorms), decoder D→D→D→1.
+    /// affine LayerNorms, the graph context's D→D if on), decoder D→D→D→1.
     pub fn num_parameters(&self) -> usize {
         let d = self.latent_dim;
         let linear = |i: usize, o: usize| i * o + o;
-        let step = linear(3 * d, d) + linear(d, d) + linear(2 * d, d) + linear(d, d) + 2 * 2 * d;
+        let context = if self.graph_context { linear(d, d) } else { 0 };
+        let step =
+            linear(3 * d, d) + linear(d, d) + linear(2 * d, d) + linear(d, d) + 2 * 2 * d + context;
         linear(self.node_features, d)
             + linear(self.edge_features, d)
             + self.steps * step
@@ -99,6 +109,8 @@ mod tests {
     fn paper_parameter_counts() {
         assert_eq!(MpnConfig::poisson().num_parameters(), 300_673);
         assert_eq!(MpnConfig::console().num_parameters(), 1_191_041);
+        let with_context = MpnConfig { graph_context: true, ..MpnConfig::poisson() };
+        assert_eq!(with_context.num_parameters(), 300_673 + 10 * (64 * 64 + 64));
     }
 
     #[test]
@@ -109,6 +121,9 @@ mod tests {
         };
         let back: MpnConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
         assert_eq!(back, c);
+        assert!(!serde_json::to_string(&c).unwrap().contains("graph_context"));
+        let on = MpnConfig { graph_context: true, ..c };
+        assert_eq!(serde_json::from_str::<MpnConfig>(&serde_json::to_string(&on).unwrap()).unwrap(), on);
         let partial: MpnConfig =
             serde_json::from_str(r#"{"latent_dim": 32, "output": "none"}"#).unwrap();
         assert_eq!(

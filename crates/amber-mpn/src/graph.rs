@@ -141,12 +141,16 @@ impl Topology {
 }
 
 /// Input of one forward pass: normalised node and edge features (rows in the order of the
-/// topology) on the network's device and dtype.
+/// topology) on the network's device and dtype, and which graph of the batch each node is in.
 #[derive(Clone, Debug)]
 pub struct GraphInput {
     pub node_features: Tensor,
     pub edge_features: Tensor,
     pub topology: Arc<Topology>,
+    /// The graph index of every node (u32, `(N)`).
+    pub graph_of_node: Tensor,
+    /// One over the node count of every graph (`(G, 1)`, the network's dtype).
+    pub inverse_graph_sizes: Tensor,
 }
 
 impl GraphInput {
@@ -169,6 +173,23 @@ impl GraphInput {
                 batch.edge_dim
             )));
         }
+        let offsets = &batch.node_offsets;
+        let graphs_partition_nodes = offsets.first() == Some(&0)
+            && offsets.last() == Some(&(n as u32))
+            && offsets.windows(2).all(|w| w[0] < w[1])
+            && batch.graph_of_node.len() == n
+            && offsets.windows(2).enumerate().all(|(g, w)| {
+                batch.graph_of_node[w[0] as usize..w[1] as usize].iter().all(|&v| v as usize == g)
+            });
+        if !graphs_partition_nodes {
+            return Err(MpnError::InvalidGraph(format!(
+                "node offsets {:?} and {} graph indices do not split {n} nodes into non-empty graphs",
+                &offsets[..offsets.len().min(8)],
+                batch.graph_of_node.len()
+            )));
+        }
+        let inverse_graph_sizes: Vec<f32> = offsets.windows(2).map(|w| 1.0 / (w[1] - w[0]) as f32).collect();
+        let inverse_graph_sizes = Tensor::from_vec(inverse_graph_sizes, (offsets.len() - 1, 1), device)?.to_dtype(dtype)?;
         let topology = Topology::new(
             n,
             batch.edge_src.clone(),
@@ -183,11 +204,17 @@ impl GraphInput {
             node_features,
             edge_features,
             topology: Arc::new(topology),
+            graph_of_node: Tensor::from_slice(&batch.graph_of_node, n, device)?,
+            inverse_graph_sizes,
         })
     }
 
     pub fn num_nodes(&self) -> usize {
         self.topology.num_nodes()
+    }
+
+    pub fn num_graphs(&self) -> usize {
+        self.inverse_graph_sizes.dims()[0]
     }
 
     /// The same graph with each directed edge dropped independently with probability `p`
@@ -199,6 +226,8 @@ impl GraphInput {
             node_features: self.node_features.clone(),
             edge_features: self.edge_features.index_select(&kept, 0)?,
             topology: Arc::new(topology),
+            graph_of_node: self.graph_of_node.clone(),
+            inverse_graph_sizes: self.inverse_graph_sizes.clone(),
         })
     }
 }

@@ -104,10 +104,26 @@ impl ResidualMlp {
     }
 }
 
-/// One message-passing step: edge update (message), mean aggregation, node update.
+/// One message-passing step: edge update (message), mean aggregation, graph context if
+/// configured, node update.
 struct Step {
     edge: ResidualMlp,
     node: ResidualMlp,
+    context: Option<Linear>,
+}
+
+impl Step {
+    /// The aggregated messages plus, with a graph context, `tanh(W·mean(x) + b)` of each node's
+    /// graph (stock candle ops: the tensors are `(G, D)`, G a handful of graphs).
+    fn with_context(&self, aggregated: Tensor, x: &Tensor, graph: &GraphInput) -> candle_core::Result<Tensor> {
+        let Some(context) = &self.context else {
+            return Ok(aggregated);
+        };
+        let graph_mean = Tensor::zeros((graph.num_graphs(), x.dim(1)?), x.dtype(), x.device())?
+            .index_add(&graph.graph_of_node, x, 0)?
+            .broadcast_mul(&graph.inverse_graph_sizes)?;
+        aggregated + context.forward(&graph_mean)?.tanh()?.index_select(&graph.graph_of_node, 0)?
+    }
 }
 
 /// The message passing network. Built from `Var`s ([`Mpn::init`], [`Mpn::load_trainable`]) it
@@ -125,7 +141,7 @@ pub struct Mpn {
 impl Mpn {
     /// Builds the network from a `VarBuilder`: parameter names are `node_encoder.weight`,
     /// `steps.{l}.edge.mlp.{0,1}.{weight,bias}`, `steps.{l}.edge.norm.{weight,bias}`, likewise
-    /// `node`, and `decoder.{0,1,2}.*`.
+    /// `node`, `steps.{l}.context.{weight,bias}` with a graph context, and `decoder.{0,1,2}.*`.
     pub fn new(config: MpnConfig, vb: VarBuilder) -> Result<Self> {
         config.validate()?;
         let d = config.latent_dim;
@@ -135,6 +151,7 @@ impl Mpn {
                 Ok(Step {
                     edge: ResidualMlp::new(vb.pp("edge"), 3 * d, d)?,
                     node: ResidualMlp::new(vb.pp("node"), 2 * d, d)?,
+                    context: config.graph_context.then(|| Linear::new(vb.pp("context"), d, d)).transpose()?,
                 })
             })
             .collect::<candle_core::Result<_>>()?;
@@ -260,6 +277,7 @@ impl Mpn {
                 .map(|s| Step {
                     edge: mlp(&s.edge),
                     node: mlp(&s.node),
+                    context: s.context.as_ref().map(linear),
                 })
                 .collect(),
             decoder: [
@@ -289,6 +307,7 @@ impl Mpn {
         for s in &self.steps {
             p.extend(s.edge.parameters());
             p.extend(s.node.parameters());
+            p.extend(s.context.iter().flat_map(|l| [&l.weight, &l.bias]));
         }
         for l in &self.decoder {
             p.extend([&l.weight, &l.bias]);
@@ -303,7 +322,7 @@ impl Mpn {
         let (mut x, mut e) = self.encode(graph)?;
         for step in &self.steps {
             e = ops::edge_update(&x, &e, &step.edge.packed()?, &graph.topology)?;
-            let a = ops::segment_mean(&e, &graph.topology)?;
+            let a = step.with_context(ops::segment_mean(&e, &graph.topology)?, &x, graph)?;
             x = ops::node_update(&x, &a, &step.node.packed()?)?;
         }
         self.decode(&x, ops::tanh)

@@ -1,6 +1,7 @@
 //! The network as a whole: parameter count, fused vs stock-candle forward and gradients,
 //! gradient coverage, input validation, checkpoints.
 
+use amber_graph::GraphBatch;
 use amber_mpn::synthetic::random_graph;
 use amber_mpn::{GraphInput, Mpn, MpnConfig, MpnError, OutputTransform};
 use candle_core::{DType, Device, Tensor};
@@ -15,8 +16,38 @@ fn small_config() -> MpnConfig {
     }
 }
 
+fn with_context(config: MpnConfig) -> MpnConfig {
+    MpnConfig {
+        graph_context: true,
+        ..config
+    }
+}
+
+/// `a` and `b` side by side, as two graphs of one batch or (`one_graph`) as one graph with two
+/// components.
+fn concat(a: &GraphBatch, b: &GraphBatch, one_graph: bool) -> GraphBatch {
+    fn shift(v: &[u32], by: usize) -> impl Iterator<Item = u32> + '_ {
+        v.iter().map(move |&x| x + by as u32)
+    }
+    let n = a.num_nodes + b.num_nodes;
+    let mut joined = a.clone();
+    joined.num_nodes = n;
+    joined.num_edges += b.num_edges;
+    joined.node_features.extend(&b.node_features);
+    joined.edge_features.extend(&b.edge_features);
+    joined.edge_src.extend(shift(&b.edge_src, a.num_nodes));
+    joined.edge_dst.extend(shift(&b.edge_dst, a.num_nodes));
+    joined.dst_offsets.extend(shift(&b.dst_offsets[1..], a.num_edges));
+    let second = if one_graph { 0 } else { 1 };
+    joined.graph_of_node.extend(std::iter::repeat_n(second, b.num_nodes));
+    joined.node_offsets = if one_graph { vec![0, n as u32] } else { vec![0, a.num_nodes as u32, n as u32] };
+    joined
+}
+
+/// A batch of two random graphs (30 and 40 nodes).
 fn graph(dtype: DType, seed: u64) -> GraphInput {
-    GraphInput::from_batch(&random_graph(40, 50, 4, 1, seed), dtype, &Device::Cpu).unwrap()
+    let batch = concat(&random_graph(30, 40, 4, 1, seed), &random_graph(40, 50, 4, 1, seed + 100), false);
+    GraphInput::from_batch(&batch, dtype, &Device::Cpu).unwrap()
 }
 
 fn values(t: &Tensor) -> Vec<f64> {
@@ -53,7 +84,13 @@ fn initialisation_is_seeded() {
 
 #[test]
 fn fused_forward_and_gradients_match_stock_candle() {
-    let (model, varmap) = Mpn::init(small_config(), 3, DType::F64, &Device::Cpu).unwrap();
+    for config in [small_config(), with_context(small_config())] {
+        fused_matches_stock_candle(config);
+    }
+}
+
+fn fused_matches_stock_candle(config: MpnConfig) {
+    let (model, varmap) = Mpn::init(config, 3, DType::F64, &Device::Cpu).unwrap();
     let mut rng = StdRng::seed_from_u64(0);
     // A dropped graph has nodes without incoming edges, the corner case of the aggregation.
     let g = graph(DType::F64, 1).drop_edges(0.5, &mut rng).unwrap();
@@ -76,7 +113,7 @@ fn fused_forward_and_gradients_match_stock_candle() {
 
 #[test]
 fn every_parameter_gets_a_gradient() {
-    let (model, varmap) = Mpn::init(small_config(), 0, DType::F32, &Device::Cpu).unwrap();
+    let (model, varmap) = Mpn::init(with_context(small_config()), 0, DType::F32, &Device::Cpu).unwrap();
     let mut rng = StdRng::seed_from_u64(0);
     let loss = model
         .forward_train(&graph(DType::F32, 2), &mut rng)
@@ -94,6 +131,32 @@ fn every_parameter_gets_a_gradient() {
             values(g).iter().any(|&v| v != 0.0),
             "{name} has an all-zero gradient"
         );
+    }
+}
+
+#[test]
+fn graph_context_reaches_across_its_graph_and_no_further() {
+    let (a, b) = (random_graph(30, 40, 4, 1, 1), random_graph(40, 50, 4, 1, 2));
+    let mut b_changed = b.clone();
+    b_changed.node_features.iter_mut().for_each(|f| *f = -*f);
+    let predict = |model: &Mpn, batch: &GraphBatch| {
+        let input = GraphInput::from_batch(batch, DType::F64, &Device::Cpu).unwrap();
+        values(&model.forward(&input).unwrap())
+    };
+    let first_graph = |model: &Mpn, b: &GraphBatch, one_graph: bool| {
+        predict(model, &concat(&a, b, one_graph))[..a.num_nodes].to_vec()
+    };
+    let (plain, _) = Mpn::init(small_config(), 1, DType::F64, &Device::Cpu).unwrap();
+    let (context, _) = Mpn::init(with_context(small_config()), 1, DType::F64, &Device::Cpu).unwrap();
+    // Without a context, a component the edges do not reach changes nothing.
+    assert_eq!(first_graph(&plain, &b, true), first_graph(&plain, &b_changed, true));
+    // With it, the other component of the same graph does; another graph of the batch does not.
+    let (same, changed) = (first_graph(&context, &b, true), first_graph(&context, &b_changed, true));
+    assert!(same.iter().zip(&changed).all(|(x, y)| (x - y).abs() > 1e-9), "{same:?} vs {changed:?}");
+    assert_eq!(first_graph(&context, &b, false), first_graph(&context, &b_changed, false));
+    let alone = predict(&context, &a);
+    for (x, y) in alone.iter().zip(first_graph(&context, &b, false)) {
+        assert!((x - y).abs() < 1e-12, "{x} alone vs {y} in a batch");
     }
 }
 

@@ -81,11 +81,15 @@ pub struct NetworkConfig {
     pub message_passing_steps: usize,
     /// Edge dropout probability during training.
     pub edge_dropout: f64,
+    /// The graph context of `amber_mpn::MpnConfig::graph_context` (not in the paper); omitted
+    /// from the JSON when off, so configurations without it keep their hashes.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub graph_context: bool,
 }
 
 impl Default for NetworkConfig {
     fn default() -> Self {
-        Self { latent_dim: 64, message_passing_steps: 10, edge_dropout: 0.1 }
+        Self { latent_dim: 64, message_passing_steps: 10, edge_dropout: 0.1, graph_context: false }
     }
 }
 
@@ -236,7 +240,7 @@ impl TrainingConfig {
     pub fn smoke() -> Self {
         Self {
             data: DataConfig { difficulty: Difficulty::Easy, train_problems: 2, val_problems: 2 },
-            network: NetworkConfig { latent_dim: 32, message_passing_steps: 4, edge_dropout: 0.1 },
+            network: NetworkConfig { latent_dim: 32, message_passing_steps: 4, ..NetworkConfig::default() },
             steps: 200,
             batch_nodes: 4_000,
             buffer_capacity: 20,

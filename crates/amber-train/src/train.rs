@@ -128,6 +128,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             steps: config.network.message_passing_steps,
             edge_dropout: config.network.edge_dropout,
             output: target.network_output(),
+            graph_context: config.network.graph_context,
         };
         let (network, varmap) = Mpn::init(network_config, config.seed, DType::F32, &Device::Cpu)?;
         let optimiser = Adam::new(&varmap, config.max_grad_norm)?;

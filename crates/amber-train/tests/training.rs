@@ -19,7 +19,7 @@ fn problems(seeds: &[u64]) -> Vec<PoissonProblem> {
 fn tiny_config(steps: u64) -> TrainingConfig {
     TrainingConfig {
         data: DataConfig { difficulty: Difficulty::Easy, train_problems: 2, val_problems: 1 },
-        network: NetworkConfig { latent_dim: 16, message_passing_steps: 3, edge_dropout: 0.1 },
+        network: NetworkConfig { latent_dim: 16, message_passing_steps: 3, ..NetworkConfig::default() },
         steps,
         batch_nodes: 1_500,
         buffer_capacity: 6,

@@ -57,6 +57,7 @@ impl Mpn {
                 .zeros_like()?
                 .index_add(&dst, &e, 0)?
                 .broadcast_mul(&inv_degree)?;
+            let a = step.with_context(a, &x, graph)?;
             x = step.node.forward_naive(&Tensor::cat(&[&x, &a], 1)?, &x)?;
         }
         self.decode(&x, Tensor::tanh)
