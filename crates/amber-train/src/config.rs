@@ -209,20 +209,22 @@ impl TrainingConfig {
         }
     }
 
-    /// The default: the best quality reachable within about 25 minutes of training per variant
-    /// on two CPU cores, on the paper's data (Poisson hard) and network. The later version's
-    /// levers (§11): residual in softplus space with normalised labels, learning rate 1e-3 with
-    /// 5 % warm-up and linear decay; plus the log-size node feature. Small batches (12,000 nodes,
-    /// about one generated mesh) so that many steps fit, an addition every 4 steps so the buffer
-    /// fills with the model's own meshes early, a 500-entry buffer. Measured (docs/PROFILES.md):
-    /// 600, 2,000 and 3,000 steps gave test normalised DCD 0.369, 0.339 and 0.324 (AMBER-Mean);
-    /// without the log-size feature validation was 0.453 instead of 0.324; learning rate 2e-3,
-    /// the log objective and a log-load feature did not help.
+    /// The default: the best quality reachable within about 30 minutes of training per variant
+    /// on two CPU cores, on the paper's data (Poisson hard). The later version's levers (§11):
+    /// residual in softplus space with normalised labels, learning rate 1e-3 with 5 % warm-up and
+    /// linear decay; plus the log-size node feature and the network's graph context. Small
+    /// batches (12,000 nodes, about one generated mesh) so that many steps fit, an addition every
+    /// 4 steps so the buffer fills with the model's own meshes early, a 500-entry buffer.
+    /// Measured (docs/PROFILES.md, AMBER-Mean, test normalised DCD): 600, 2,000 and 3,000 steps
+    /// gave 0.369, 0.339 and 0.324 without the graph context, 0.277 with it at 3,000; without the
+    /// log-size feature validation was 0.453 instead of 0.324; learning rate 2e-3, the log
+    /// objective and a log-load feature did not help.
     pub fn quick() -> Self {
         Self {
             objective: Objective::SoftplusResidual,
             normalise_labels: true,
             log_size_feature: true,
+            network: NetworkConfig { graph_context: true, ..NetworkConfig::default() },
             steps: 3_000,
             learning_rate: 1e-3,
             lr_schedule: LrSchedule::WarmupLinearDecay { warmup_fraction: 0.05 },
@@ -240,7 +242,7 @@ impl TrainingConfig {
     pub fn smoke() -> Self {
         Self {
             data: DataConfig { difficulty: Difficulty::Easy, train_problems: 2, val_problems: 2 },
-            network: NetworkConfig { latent_dim: 32, message_passing_steps: 4, ..NetworkConfig::default() },
+            network: NetworkConfig { latent_dim: 32, message_passing_steps: 4, ..Self::quick().network },
             steps: 200,
             batch_nodes: 4_000,
             buffer_capacity: 20,
