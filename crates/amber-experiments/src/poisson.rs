@@ -11,11 +11,10 @@ use anyhow::bail;
 use serde::Serialize;
 
 use crate::method::{Method, MethodSpec, Variant};
-use crate::report::merge_json;
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::progress::item_bar;
-use crate::report::{commit, machine, read_json};
+use crate::report::{commit, machine, merge_json, read_json};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 

@@ -188,8 +188,11 @@ impl GraphInput {
                 batch.graph_of_node.len()
             )));
         }
-        let inverse_graph_sizes: Vec<f32> = offsets.windows(2).map(|w| 1.0 / (w[1] - w[0]) as f32).collect();
-        let inverse_graph_sizes = Tensor::from_vec(inverse_graph_sizes, (offsets.len() - 1, 1), device)?.to_dtype(dtype)?;
+        let inverse_graph_sizes: Vec<f32> =
+            offsets.windows(2).map(|w| 1.0 / (w[1] - w[0]) as f32).collect();
+        let inverse_graph_sizes =
+            Tensor::from_vec(inverse_graph_sizes, (offsets.len() - 1, 1), device)?
+                .to_dtype(dtype)?;
         let topology = Topology::new(
             n,
             batch.edge_src.clone(),

@@ -115,7 +115,12 @@ struct Step {
 impl Step {
     /// The aggregated messages plus, with a graph context, `tanh(W·mean(x) + b)` of each node's
     /// graph (stock candle ops: the tensors are `(G, D)`, G a handful of graphs).
-    fn with_context(&self, aggregated: Tensor, x: &Tensor, graph: &GraphInput) -> candle_core::Result<Tensor> {
+    fn with_context(
+        &self,
+        aggregated: Tensor,
+        x: &Tensor,
+        graph: &GraphInput,
+    ) -> candle_core::Result<Tensor> {
         let Some(context) = &self.context else {
             return Ok(aggregated);
         };
@@ -151,7 +156,10 @@ impl Mpn {
                 Ok(Step {
                     edge: ResidualMlp::new(vb.pp("edge"), 3 * d, d)?,
                     node: ResidualMlp::new(vb.pp("node"), 2 * d, d)?,
-                    context: config.graph_context.then(|| Linear::new(vb.pp("context"), d, d)).transpose()?,
+                    context: config
+                        .graph_context
+                        .then(|| Linear::new(vb.pp("context"), d, d))
+                        .transpose()?,
                 })
             })
             .collect::<candle_core::Result<_>>()?;

@@ -266,6 +266,12 @@ fn wrong_feature_dimensions_are_errors() {
         model.predict(&broken),
         Err(MpnError::InvalidGraph(_))
     ));
+    for node_offsets in [vec![0, 5], vec![0, 0, 10], vec![0, 4, 10]] {
+        // Too few nodes, an empty graph, offsets that disagree with `graph_of_node`.
+        let mut split = random_graph(10, 10, 4, 1, 0);
+        split.node_offsets = node_offsets;
+        assert!(matches!(model.predict(&split), Err(MpnError::InvalidGraph(_))));
+    }
 }
 
 #[test]
