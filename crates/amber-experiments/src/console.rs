@@ -87,8 +87,8 @@ impl ConsoleExperiment {
                 }
                 if self.profile == Profile::Quick {
                     // A batch is at least one whole part (1.4k–42k elements), and D = 128 trains at
-                    // ~7.5k nodes/s here: 800 steps took 16–20 minutes; 1,200 score better and
-                    // add 8–10 minutes per variant, ~80 for the experiment (docs/PROFILES.md).
+                    // ~8k nodes/s here: 800 steps took 16–20 minutes; 1,200 score better and
+                    // take ~25 per variant, 70 for the whole experiment alone (docs/PROFILES.md).
                     config.steps = 1200;
                     config.validation_interval = 400;
                 }
