@@ -116,6 +116,7 @@ impl PoissonExperiment {
             variant(Method::AmberMax, "no-softplus", serde_json::json!({ "objective": "linear", "normalise_labels": false })),
             variant(Method::AmberMax, "random-buffer", serde_json::json!({ "source_selection": "uniform" })),
             variant(Method::AmberMax, "no-input-normalisation", serde_json::json!({ "normalise_inputs": false })),
+            variant(Method::AmberMean, "graph-context", serde_json::json!({ "network": { "graph_context": true } })),
         ];
         let cnn = Method::Cnn { resolution: if profile == Profile::Smoke { 32 } else { 256 } };
         experiment.methods.extend([

@@ -81,7 +81,10 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     experiment.runs_root = dir.path().join("data/runs");
     experiment.out = dir.path().join("results/ablate");
     // Few steps: this checks the plumbing of every variant, not their quality.
-    experiment.overrides = serde_json::json!({ "steps": 24, "checkpoint_interval": 12, "validation_interval": 0 });
+    amber_experiments::merge_json(
+        &mut experiment.overrides,
+        &serde_json::json!({ "steps": 24, "checkpoint_interval": 12, "validation_interval": 0 }),
+    );
     experiment.cnn_overrides = serde_json::json!({ "steps": 4, "checkpoint_interval": 2 });
     let results = experiment.run().unwrap();
     assert_eq!(results.experiment, "ablate");
@@ -96,6 +99,7 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
             "amber-max (no-softplus)",
             "amber-max (random-buffer)",
             "amber-max (no-input-normalisation)",
+            "amber-mean (graph-context)",
             "cnn-32",
             "cnn-32 (softplus-mse)",
             "cnn-32 (plain-mse)",
@@ -111,10 +115,13 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     assert_eq!(training(4)["amber"]["objective"], "linear");
     assert_eq!(training(5)["amber"]["source_selection"], "uniform");
     assert_eq!(training(6)["amber"]["normalise_inputs"], false);
-    assert_eq!(training(8)["cnn"]["loss"], "softplus_mse");
-    assert_eq!(training(9)["cnn"]["loss"], "mse");
-    assert_eq!(training(10)["cnn"]["aggregation"], "max");
-    assert_eq!(training(12)["amber"]["data"]["train_problems"], 3);
+    // The ablations run on the paper's network, the graph context being a variant.
+    assert_eq!(training(0)["amber"]["network"].get("graph_context"), None);
+    assert_eq!(training(7)["amber"]["network"]["graph_context"], true);
+    assert_eq!(training(9)["cnn"]["loss"], "softplus_mse");
+    assert_eq!(training(10)["cnn"]["loss"], "mse");
+    assert_eq!(training(11)["cnn"]["aggregation"], "max");
+    assert_eq!(training(13)["amber"]["data"]["train_problems"], 3);
     for run in &results.runs {
         let steps = if run.method.starts_with("cnn") { 1 } else { 3 };
         assert!(run.ndcd.is_finite() && run.ndcd_per_step.len() == steps, "{run:?}");
