@@ -10,6 +10,7 @@ mod bench_mesher3d;
 mod bench_metrics;
 mod bench_mpn;
 mod dataset;
+mod label_rollouts;
 mod reference_distances;
 mod report;
 mod reproduce;
@@ -32,6 +33,9 @@ enum Command {
     Dataset(dataset::Args),
     /// d(M⁰, M*) and d(M̂, M*) on a dataset split: the anchors of the normalised DCD.
     ReferenceDistances(reference_distances::Args),
+    /// Rollouts that mesh the projected expert labels instead of predictions: the ceiling of
+    /// imitation, per generation step.
+    LabelRollouts(label_rollouts::Args),
     /// Reproduce an experiment of the paper: results.json, table.md and plots under results/.
     Reproduce(reproduce::Args),
     /// The paper's ablations on Poisson hard (results/ablate/).
@@ -74,6 +78,7 @@ fn main() -> anyhow::Result<()> {
         Command::Bench(Bench::Cnn(args)) => bench_cnn::run(args),
         Command::Dataset(args) => dataset::run(args),
         Command::ReferenceDistances(args) => reference_distances::run(args),
+        Command::LabelRollouts(args) => label_rollouts::run(args),
         Command::Reproduce(args) => reproduce::run(args),
         Command::Ablate(args) => reproduce::ablate(args),
     }

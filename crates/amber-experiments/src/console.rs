@@ -82,6 +82,8 @@ impl ConsoleExperiment {
         Ok(match spec.method {
             Method::AmberMean | Method::AmberMax => {
                 let mut config = TrainingConfig::profile(self.profile);
+                // The error indicator is a Poisson input: Console parts have no solution.
+                config.error_indicator_feature = false;
                 if self.profile != Profile::Smoke {
                     config.network.latent_dim = 128;
                 }

@@ -84,14 +84,16 @@ impl PoissonExperiment {
     /// training code: AMBER-Mean and AMBER-Max as configured (their per-step curves are the
     /// generation-steps study), both with the CNN's log-MSE loss, AMBER-Max without the softplus
     /// output, with uniformly random buffer additions, without input normalisation, with 5, 10,
-    /// 50 and 100 training problems (20 is the default); the 256² CNN with its log-MSE loss,
+    /// 50 and 100 training problems (20 is the default); AMBER-Mean with each of the quick
+    /// profile's two additions (graph context, error-indicator feature); the 256² CNN with its log-MSE loss,
     /// with MSE after a softplus, with plain MSE on raw sizes, and with max-aggregated labels.
     /// Writes `results/ablate/`.
     pub fn ablation(profile: Profile) -> Self {
         let mut experiment = Self::new(profile);
-        // The ablations vary the paper's choices on the paper's network: without the graph
-        // context of the quick profile.
-        experiment.overrides = serde_json::json!({ "network": { "graph_context": false } });
+        // The ablations vary the paper's choices on the paper's network and inputs: without the
+        // graph context and the error-indicator feature of the quick profile.
+        experiment.overrides =
+            serde_json::json!({ "network": { "graph_context": false }, "error_indicator_feature": false });
         if profile == Profile::Quick {
             // Fifteen runs in three hours on two cores: each AMBER run gets 600 of the
             // reproduction's 3,000 steps (4–5 min of training on Poisson hard); the 256² CNNs
@@ -117,6 +119,7 @@ impl PoissonExperiment {
             variant(Method::AmberMax, "random-buffer", serde_json::json!({ "source_selection": "uniform" })),
             variant(Method::AmberMax, "no-input-normalisation", serde_json::json!({ "normalise_inputs": false })),
             variant(Method::AmberMean, "graph-context", serde_json::json!({ "network": { "graph_context": true } })),
+            variant(Method::AmberMean, "error-indicator", serde_json::json!({ "error_indicator_feature": true })),
         ];
         let cnn = Method::Cnn { resolution: if profile == Profile::Smoke { 32 } else { 256 } };
         experiment.methods.extend([

@@ -100,6 +100,7 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
             "amber-max (random-buffer)",
             "amber-max (no-input-normalisation)",
             "amber-mean (graph-context)",
+            "amber-mean (error-indicator)",
             "cnn-32",
             "cnn-32 (softplus-mse)",
             "cnn-32 (plain-mse)",
@@ -115,13 +116,15 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     assert_eq!(training(4)["amber"]["objective"], "linear");
     assert_eq!(training(5)["amber"]["source_selection"], "uniform");
     assert_eq!(training(6)["amber"]["normalise_inputs"], false);
-    // The ablations run on the paper's network, the graph context being a variant.
+    // The ablations run on the paper's network and inputs, the graph context being a variant.
     assert_eq!(training(0)["amber"]["network"].get("graph_context"), None);
+    assert_eq!(training(0)["amber"].get("error_indicator_feature"), None);
     assert_eq!(training(7)["amber"]["network"]["graph_context"], true);
-    assert_eq!(training(9)["cnn"]["loss"], "softplus_mse");
-    assert_eq!(training(10)["cnn"]["loss"], "mse");
-    assert_eq!(training(11)["cnn"]["aggregation"], "max");
-    assert_eq!(training(13)["amber"]["data"]["train_problems"], 3);
+    assert_eq!(training(8)["amber"]["error_indicator_feature"], true);
+    assert_eq!(training(10)["cnn"]["loss"], "softplus_mse");
+    assert_eq!(training(11)["cnn"]["loss"], "mse");
+    assert_eq!(training(12)["cnn"]["aggregation"], "max");
+    assert_eq!(training(14)["amber"]["data"]["train_problems"], 3);
     for run in &results.runs {
         let steps = if run.method.starts_with("cnn") { 1 } else { 3 };
         assert!(run.ndcd.is_finite() && run.ndcd_per_step.len() == steps, "{run:?}");

@@ -41,7 +41,7 @@ pub use model::{AmberModel, Predictor, WEIGHTS_FILE};
 pub use optim::Adam;
 pub use target::{TargetTransform, softplus, softplus_inverse};
 pub use task::{
-    Column, LOG_LOAD_COLUMN, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, StepOutcome,
-    generation_step, labels, with_log_load, with_log_size,
+    Column, LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError,
+    StepOutcome, generation_step, labels, with_error_indicator, with_log_load, with_log_size,
 };
 pub use train::{Addition, CONFIG_FILE, LOG_FILE, MODEL_DIR, StepReport, Training, TrainingObserver};

@@ -69,7 +69,8 @@ impl Problem<2> for PoissonProblem {
     }
 
     /// Solves −Δu = f (P1) on `mesh`: `solution_mean`, `solution_std` of u over each element's
-    /// vertices, and `load` = f at the element midpoint.
+    /// vertices, `load` = f at the element midpoint, and ln η_K (read only by
+    /// [`with_error_indicator`]).
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
         let order = self
             .metadata
@@ -78,13 +79,19 @@ impl Problem<2> for PoissonProblem {
             .map_or(ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order);
         let space = P1Space::new(mesh)?;
         let quadrature = Quadrature::simplex::<2>(order)?;
-        let solution = space.solve_poisson(&space.sample_load(&self.load, &quadrature)?)?;
+        let samples = space.sample_load(&self.load, &quadrature)?;
+        let solution = space.solve_poisson(&samples)?;
         let stats = element_stats(mesh, &solution.u)?;
+        let indicator = space.residual_estimator(&solution.u, &samples)?;
         let load = mesh.midpoints().into_iter().map(|x| amber_fem::Load::value(&self.load, x)).collect();
         Ok(vec![
             Column { name: "solution_mean".into(), values: stats.iter().map(|s| s.mean).collect() },
             Column { name: "solution_std".into(), values: stats.iter().map(|s| s.std).collect() },
             Column { name: "load".into(), values: load },
+            Column {
+                name: LOG_ERROR_INDICATOR_COLUMN.into(),
+                values: indicator.iter().map(|eta| eta.max(f64::MIN_POSITIVE).ln()).collect(),
+            },
         ])
     }
 
@@ -168,6 +175,17 @@ pub const LOG_LOAD_COLUMN: &str = "log_load";
 /// refines well into the flanks. Derived from the task's `load` column (Poisson only).
 pub fn with_log_load(mut features: FeatureSet) -> FeatureSet {
     features.node.push(NodeFeature::Column(LOG_LOAD_COLUMN.into()));
+    features
+}
+
+/// Name of the Poisson column ln η_K (see [`with_error_indicator`]).
+pub const LOG_ERROR_INDICATOR_COLUMN: &str = "log_error_indicator";
+
+/// `features` with ln η_K appended (Poisson only): the residual error indicator of the current
+/// solution, the quantity the expert's refinement loop marks by. An adaptive solver computes it
+/// anyway; the network still has to learn where 75 marking rounds end up from one estimate.
+pub fn with_error_indicator(mut features: FeatureSet) -> FeatureSet {
+    features.node.push(NodeFeature::Column(LOG_ERROR_INDICATOR_COLUMN.into()));
     features
 }
 

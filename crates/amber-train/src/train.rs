@@ -23,7 +23,8 @@ use crate::model::{WEIGHTS_FILE, read_json, write_json};
 use crate::optim::Adam;
 use crate::{
     AmberModel, Evaluation, EvaluationSummary, MeshLimits, MeshState, Predictor, Problem, ProblemError, ReplayBuffer,
-    Sample, StepOutcome, TargetTransform, TrainingConfig, generation_step, labels, with_log_load, with_log_size,
+    Sample, StepOutcome, TargetTransform, TrainingConfig, generation_step, labels, with_error_indicator, with_log_load,
+    with_log_size,
 };
 
 /// The final model's sub-directory of the output directory.
@@ -112,6 +113,9 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         }
         if config.log_load_feature {
             features = with_log_load(features);
+        }
+        if config.error_indicator_feature {
+            features = with_error_indicator(features);
         }
         let limits = MeshLimits::from_experts(
             problems.iter().map(|p| p.expert_mesh()),

@@ -227,8 +227,8 @@ fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
 }
 
 #[test]
-fn the_optional_log_features_reach_a_saved_model_that_predicts_on_new_meshes() {
-    let config = TrainingConfig { log_load_feature: true, ..tiny_config(3) };
+fn the_optional_features_reach_a_saved_model_that_predicts_on_new_meshes() {
+    let config = TrainingConfig { log_load_feature: true, error_indicator_feature: true, ..tiny_config(3) };
     let problems = problems(&[11, 12]);
     let mut training = Training::new(config, problems.clone()).unwrap();
     for _ in 0..3 {
@@ -240,7 +240,8 @@ fn the_optional_log_features_reach_a_saved_model_that_predicts_on_new_meshes() {
     let names: Vec<String> = model.predictor.features.node.iter().map(|f| format!("{f:?}")).collect();
     assert!(names.iter().any(|n| n.contains(amber_train::LOG_SIZE_COLUMN)), "{names:?}");
     assert!(names.iter().any(|n| n.contains(amber_train::LOG_LOAD_COLUMN)), "{names:?}");
-    assert_eq!(model.network.config().node_features, 6, "the paper's 4 node features + 2");
+    assert!(names.iter().any(|n| n.contains(amber_train::LOG_ERROR_INDICATOR_COLUMN)), "{names:?}");
+    assert_eq!(model.network.config().node_features, 7, "the paper's 4 node features + 3");
 
     let problem = &problems[0];
     let state =
