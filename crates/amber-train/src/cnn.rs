@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use amber_cnn::{CnnLoss, PixelGrid, Raster, UNet, UNetConfig};
-use amber_graph::{Aggregation, RunningMoments, VARIANCE_EPSILON};
+use amber_graph::{Aggregation, GraphError, NodeFeature, RunningMoments, VARIANCE_EPSILON};
 use amber_mesh::Mesh;
 use amber_meshgen::SizingField;
 use candle_core::{DType, Device, Tensor};
@@ -224,8 +224,24 @@ fn rasterise<const D: usize, P: Problem<D> + ?Sized>(
     let cap = (4.0 * expected) as usize + 1_000;
     let auxiliary = problem.remesh(initial, vec![size; initial.num_elements()], cap).map_err(in_problem(index))?;
     let raster = Raster::new(grid, &auxiliary)?;
+    // The task's own input columns, in its feature set's order: a problem may compute more
+    // (optional AMBER inputs) than the baseline reads.
     let columns = problem.columns(&auxiliary).map_err(in_problem(index))?;
-    let values: Vec<&[f64]> = columns.iter().map(|c| c.values.as_slice()).collect();
+    let values: Vec<&[f64]> = problem
+        .feature_set()
+        .node
+        .iter()
+        .filter_map(|feature| match feature {
+            NodeFeature::Column(name) => Some(name),
+            _ => None,
+        })
+        .map(|name| {
+            let column = columns.iter().find(|c| &c.name == name);
+            column
+                .map(|c| c.values.as_slice())
+                .ok_or_else(|| in_problem(index)(GraphError::MissingColumn { name: name.clone() }))
+        })
+        .collect::<Result<_>>()?;
     let channels = raster.channels(&values)?;
     Ok(Rasterised { auxiliary, raster, channels })
 }
@@ -791,7 +807,7 @@ mod tests {
 
     impl Problem<3> for CubeProblem {
         fn feature_set(&self) -> FeatureSet {
-            FeatureSet::poisson()
+            FeatureSet::console()
         }
 
         fn initial_mesh(&self) -> &Mesh3 {

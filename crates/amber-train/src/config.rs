@@ -139,8 +139,9 @@ pub struct TrainingConfig {
     pub log_load_feature: bool,
     /// Append ln η_K, the expert's residual error indicator on the current mesh (see
     /// [`crate::with_error_indicator`]; Poisson only); not in the paper. Left out of the
-    /// serialised config when off.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    /// serialised config when off, so configurations without it keep their hashes; hence absent
+    /// means off, not the quick profile's on.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub error_indicator_feature: bool,
     /// The network.
     pub network: NetworkConfig,
@@ -367,7 +368,13 @@ mod tests {
             assert_eq!(profile.name().parse::<Profile>().unwrap(), profile);
         }
         let partial: TrainingConfig = serde_json::from_str(r#"{"steps": 10, "aggregation": "max"}"#).unwrap();
-        assert_eq!(partial, TrainingConfig { steps: 10, aggregation: Aggregation::Max, ..TrainingConfig::quick() });
+        let expected = TrainingConfig {
+            steps: 10,
+            aggregation: Aggregation::Max,
+            error_indicator_feature: false,
+            ..TrainingConfig::quick()
+        };
+        assert_eq!(partial, expected, "absent fields are the quick profile's, but an absent optional input is off");
         assert!(serde_json::from_str::<TrainingConfig>(r#"{"stepz": 10}"#).is_err());
         let bad = TrainingConfig { objective: Objective::Softplus, normalise_labels: true, ..TrainingConfig::quick() };
         assert!(bad.validate().is_err());
