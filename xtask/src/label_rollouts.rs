@@ -7,9 +7,8 @@
 use std::path::PathBuf;
 
 use amber_graph::Aggregation;
-use amber_metrics::{compare_meshes, normalised_dcd};
 use amber_tasks::poisson::read_split;
-use amber_train::{MeshLimits, Problem, Reference, StepOutcome, TrainingConfig, generation_step, labels};
+use amber_train::{MeshLimits, MeshMetrics, Problem, Reference, StepOutcome, TrainingConfig, generation_step, labels};
 use anyhow::Context;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -89,9 +88,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                     StepOutcome::Meshed(next) => mesh = next,
                     StepOutcome::OverBudget { .. } | StepOutcome::Failed { .. } => row.failed_steps += 1,
                 }
-                let dcd = compare_meshes(&mesh, p.expert_mesh()).with_context(context)?.midpoints.dcd;
-                row.normalised_dcd.push(normalised_dcd(dcd, reference.initial_dcd, reference.reconstruction_dcd)?);
-                row.elements.push(mesh.num_elements());
+                let metrics = MeshMetrics::of(&mesh, p.expert_mesh(), &reference).with_context(context)?;
+                row.normalised_dcd.push(metrics.normalised_dcd);
+                row.elements.push(metrics.elements);
             }
             Ok(row)
         })

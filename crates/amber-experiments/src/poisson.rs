@@ -85,8 +85,9 @@ impl PoissonExperiment {
     /// generation-steps study), both with the CNN's log-MSE loss, AMBER-Max without the softplus
     /// output, with uniformly random buffer additions, without input normalisation, with 5, 10,
     /// 50 and 100 training problems (20 is the default); AMBER-Mean with each of the quick
-    /// profile's two additions (graph context, error-indicator feature); the 256² CNN with its log-MSE loss,
-    /// with MSE after a softplus, with plain MSE on raw sizes, and with max-aggregated labels.
+    /// profile's two additions (graph context, error-indicator feature); the 256² CNN with its
+    /// log-MSE loss, with MSE after a softplus, with plain MSE on raw sizes, and with
+    /// max-aggregated labels.
     /// Writes `results/ablate/`.
     pub fn ablation(profile: Profile) -> Self {
         let mut experiment = Self::new(profile);
@@ -95,8 +96,8 @@ impl PoissonExperiment {
         experiment.overrides =
             serde_json::json!({ "network": { "graph_context": false }, "error_indicator_feature": false });
         if profile == Profile::Quick {
-            // Fifteen runs in three hours on two cores: each AMBER run gets 600 of the
-            // reproduction's 3,000 steps (4–5 min of training on Poisson hard); the 256² CNNs
+            // Seventeen runs in three hours on two cores: each AMBER run gets 600 of the
+            // reproduction's 2,500 steps (4–5 min of training on Poisson hard); the 256² CNNs
             // keep their quick schedule (~10 min). The variants are compared with the defaults
             // trained on the same schedule (docs/PROFILES.md).
             merge_json(

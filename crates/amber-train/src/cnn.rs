@@ -24,12 +24,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, fingerprints, seeded_stream};
 use crate::error::{Result, TrainError, in_problem, io_error};
-use crate::inference::metrics;
 use crate::model::{read_json, write_json};
 use crate::optim::Adam;
 use crate::{
-    BufferEntry, DataConfig, MeshLimits, Problem, Profile, Reference, Rollout, RolloutStep, StepOutcome, StepStatus,
-    generation_step, labels,
+    BufferEntry, DataConfig, MeshLimits, MeshMetrics, Problem, Profile, Reference, Rollout, RolloutStep, StepOutcome,
+    StepStatus, generation_step, labels,
 };
 
 /// File of the U-Net weights (and BatchNorm statistics) inside a CNN model directory.
@@ -353,10 +352,10 @@ fn rollout<const D: usize, P: Problem<D>>(
 ) -> Result<Rollout<D>> {
     let sample = rasterise(problem, i, predictor.resolution)?;
     let sizes = predictor.predict(network, &sample)?;
-    let initial = metrics(problem.initial_mesh(), problem.expert_mesh(), reference).map_err(in_problem(i))?;
+    let initial = MeshMetrics::of(problem.initial_mesh(), problem.expert_mesh(), reference).map_err(in_problem(i))?;
     let step = match generation_step(problem, &sample.auxiliary, sizes, &predictor.limits) {
         StepOutcome::Meshed(mesh) => {
-            let metrics = metrics(&mesh, problem.expert_mesh(), reference).map_err(in_problem(i))?;
+            let metrics = MeshMetrics::of(&mesh, problem.expert_mesh(), reference).map_err(in_problem(i))?;
             RolloutStep { status: StepStatus::Meshed, mesh, metrics }
         }
         StepOutcome::OverBudget { estimated_elements } => RolloutStep {

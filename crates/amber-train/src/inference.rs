@@ -90,19 +90,22 @@ pub struct Rollout<const D: usize> {
     pub reconstruction_dcd: f64,
 }
 
-pub(crate) fn metrics<const D: usize>(
-    mesh: &Mesh<D>,
-    expert: &Mesh<D>,
-    reference: &Reference<D>,
-) -> Result<MeshMetrics, ProblemError> {
-    let c = compare_meshes(mesh, expert)?;
-    Ok(MeshMetrics {
-        dcd: c.midpoints.dcd,
-        normalised_dcd: normalised_dcd(c.midpoints.dcd, reference.initial_dcd, reference.reconstruction_dcd)?,
-        chamfer: c.midpoints.chamfer,
-        volume_difference: c.volume.summed,
-        elements: mesh.num_elements(),
-    })
+impl MeshMetrics {
+    /// The metrics of `mesh` against `expert`, normalised by the problem's `reference`.
+    pub fn of<const D: usize>(
+        mesh: &Mesh<D>,
+        expert: &Mesh<D>,
+        reference: &Reference<D>,
+    ) -> Result<Self, ProblemError> {
+        let c = compare_meshes(mesh, expert)?;
+        Ok(Self {
+            dcd: c.midpoints.dcd,
+            normalised_dcd: normalised_dcd(c.midpoints.dcd, reference.initial_dcd, reference.reconstruction_dcd)?,
+            chamfer: c.midpoints.chamfer,
+            volume_difference: c.volume.summed,
+            elements: mesh.num_elements(),
+        })
+    }
 }
 
 /// Rolls out `steps` generation steps on every problem in lockstep (one batched prediction per
@@ -126,7 +129,7 @@ pub fn rollouts<const D: usize, P: Problem<D>>(
         .enumerate()
         .map(|(i, (p, r))| {
             Ok(Rollout {
-                initial: metrics(p.initial_mesh(), p.expert_mesh(), r).map_err(in_problem(i))?,
+                initial: MeshMetrics::of(p.initial_mesh(), p.expert_mesh(), r).map_err(in_problem(i))?,
                 steps: Vec::with_capacity(steps),
                 initial_dcd: r.initial_dcd,
                 reconstruction_dcd: r.reconstruction_dcd,
@@ -176,7 +179,7 @@ pub fn rollouts<const D: usize, P: Problem<D>>(
             let previous = rollout.steps.iter().rev().nth(1).map_or(rollout.initial, |s| s.metrics);
             let step = rollout.steps.last_mut().expect("pushed above");
             step.metrics = match step.status {
-                StepStatus::Meshed => metrics(&step.mesh, p.expert_mesh(), r).map_err(in_problem(i))?,
+                StepStatus::Meshed => MeshMetrics::of(&step.mesh, p.expert_mesh(), r).map_err(in_problem(i))?,
                 // The mesh was carried forward, and so are its metrics.
                 _ => previous,
             };
