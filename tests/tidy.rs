@@ -64,9 +64,46 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("amber-mpn", &["amber-graph"]),
     ("amber-cnn", &["amber-mesh", "amber-meshgen", "amber-graph"]),
     ("amber-tasks", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics"]),
-    ("amber-train", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics", "amber-mpn", "amber-cnn", "amber-tasks"]),
-    ("amber-experiments", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics", "amber-mpn", "amber-cnn", "amber-tasks", "amber-train"]),
-    ("amber-cli", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics", "amber-tasks", "amber-train", "amber-experiments"]),
+    (
+        "amber-train",
+        &[
+            "amber-mesh",
+            "amber-meshgen",
+            "amber-fem",
+            "amber-graph",
+            "amber-metrics",
+            "amber-mpn",
+            "amber-cnn",
+            "amber-tasks",
+        ],
+    ),
+    (
+        "amber-experiments",
+        &[
+            "amber-mesh",
+            "amber-meshgen",
+            "amber-fem",
+            "amber-graph",
+            "amber-metrics",
+            "amber-mpn",
+            "amber-cnn",
+            "amber-tasks",
+            "amber-train",
+        ],
+    ),
+    (
+        "amber-cli",
+        &[
+            "amber-mesh",
+            "amber-meshgen",
+            "amber-fem",
+            "amber-graph",
+            "amber-metrics",
+            "amber-tasks",
+            "amber-train",
+            "amber-experiments",
+        ],
+    ),
 ];
 
 #[test]
@@ -75,7 +112,8 @@ fn crates_only_depend_downward() {
         let dir = entry.unwrap().path();
         let name = dir.file_name().unwrap().to_str().unwrap().to_string();
         let allowed = ALLOWED.iter().find(|(n, _)| *n == name).map(|(_, a)| *a);
-        let allowed = allowed.unwrap_or_else(|| panic!("crate {name} is missing from the layering table in tests/tidy.rs"));
+        let allowed =
+            allowed.unwrap_or_else(|| panic!("crate {name} is missing from the layering table in tests/tidy.rs"));
         let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
         let deps = manifest.split("[dependencies]").nth(1).unwrap_or("").split("\n[").next().unwrap_or("");
         for line in deps.lines() {

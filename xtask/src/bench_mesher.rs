@@ -47,10 +47,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut cases = Vec::new();
     for (name, scale) in [("graded-10k", 0.21), ("graded-100k", 0.0666), ("graded-1M", 0.021)] {
         let field = FnSize(graded_field(scale));
-        let (mesh, seconds, cpu) = median_time(args.repeats, || generate_2d(&domain, &field, &Mesh2dParams::default()))?;
+        let (mesh, seconds, cpu) =
+            median_time(args.repeats, || generate_2d(&domain, &field, &Mesh2dParams::default()))?;
         cases.push(case(name, &mesh, seconds, cpu, QualityReport::measure(&mesh, &field)));
     }
-    for (name, triangles) in [("spade-refine-uniform-10k", 1e4), ("spade-refine-uniform-100k", 1e5), ("spade-refine-uniform-1M", 1e6)] {
+    for (name, triangles) in
+        [("spade-refine-uniform-10k", 1e4), ("spade-refine-uniform-100k", 1e5), ("spade-refine-uniform-1M", 1e6)]
+    {
         let max_area = 1.5 * domain.area() / triangles;
         let (mesh, seconds, cpu) = median_time(args.repeats, || spade_uniform(&domain, max_area))?;
         // Sizes measured against the regular triangle of half the area cap (refine's typical area).
@@ -72,7 +75,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             c.quality.mean_min_angle
         );
     }
-    write_json(&args.out, &serde_json::json!({ "benchmark": "mesher", "settings": args, "machine": crate::report::machine(), "cases": cases }))
+    write_json(
+        &args.out,
+        &serde_json::json!({ "benchmark": "mesher", "settings": args, "machine": crate::report::machine(), "cases": cases }),
+    )
 }
 
 fn case(name: &str, mesh: &Mesh2, seconds: f64, cpu_seconds: f64, quality: QualityReport) -> Case {
@@ -89,7 +95,10 @@ fn case(name: &str, mesh: &Mesh2, seconds: f64, cpu_seconds: f64, quality: Quali
 }
 
 /// Runs `make` `repeats` times; returns its last result and the median wall and thread-CPU times.
-fn median_time<T, E: Into<anyhow::Error>>(repeats: usize, mut make: impl FnMut() -> Result<T, E>) -> anyhow::Result<(T, f64, f64)> {
+fn median_time<T, E: Into<anyhow::Error>>(
+    repeats: usize,
+    mut make: impl FnMut() -> Result<T, E>,
+) -> anyhow::Result<(T, f64, f64)> {
     let mut wall = Vec::new();
     let mut cpu = Vec::new();
     let mut last = None;
@@ -119,7 +128,8 @@ fn spade_uniform(domain: &PolygonDomain, max_area: f64) -> anyhow::Result<Mesh2>
     let outer = domain.outer();
     let points = outer.iter().map(|p| Point2::new(p[0], p[1])).collect();
     let edges = (0..outer.len()).map(|i| [i, (i + 1) % outer.len()]).collect();
-    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(points, edges).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(points, edges)
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
     let result = cdt.refine(
         RefinementParameters::new()
             .with_max_allowed_area(max_area)

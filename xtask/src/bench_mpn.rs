@@ -58,16 +58,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut cases = Vec::new();
     for variant in &args.variants {
         // Dropout only exists in training.
-        for mode in args
-            .modes
-            .iter()
-            .filter(|m| !(variant == "fast-dropout" && *m == "infer"))
-        {
-            let nodes = if variant == "naive" && mode == "train" {
-                args.naive_nodes.min(args.nodes)
-            } else {
-                args.nodes
-            };
+        for mode in args.modes.iter().filter(|m| !(variant == "fast-dropout" && *m == "infer")) {
+            let nodes =
+                if variant == "naive" && mode == "train" { args.naive_nodes.min(args.nodes) } else { args.nodes };
             let edges = args.edges * nodes / args.nodes;
             let case = bench_case(&config, variant, mode, nodes, edges, &args)?;
             println!(
@@ -121,20 +114,12 @@ fn bench_case(
 ) -> anyhow::Result<Value> {
     let dev = Device::Cpu;
     let graph = GraphInput::from_batch(
-        &random_graph(
-            nodes,
-            edges / 2,
-            config.node_features,
-            config.edge_features,
-            0,
-        ),
+        &random_graph(nodes, edges / 2, config.node_features, config.edge_features, 0),
         DType::F32,
         &dev,
     )?;
     // Sizing-field-like positive targets in [0.01, 0.06), deterministic.
-    let targets: Vec<f32> = (0..nodes)
-        .map(|i| 0.01 + 0.05 * ((i as f32 * 0.618_034) % 1.0))
-        .collect();
+    let targets: Vec<f32> = (0..nodes).map(|i| 0.01 + 0.05 * ((i as f32 * 0.618_034) % 1.0)).collect();
     let targets = Tensor::from_vec(targets, nodes, &dev)?;
     let (model, varmap) = Mpn::init(config.clone(), 0, DType::F32, &dev)?;
     let mut trainer = Trainer::new(&varmap, &TrainConfig::default())?;
@@ -204,13 +189,7 @@ fn reset_peak_rss() -> bool {
 
 fn peak_rss_gib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let kib: f64 = status
-        .lines()
-        .find(|l| l.starts_with("VmHWM:"))?
-        .split_whitespace()
-        .nth(1)?
-        .parse()
-        .ok()?;
+    let kib: f64 = status.lines().find(|l| l.starts_with("VmHWM:"))?.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib / (1024.0 * 1024.0))
 }
 
@@ -227,13 +206,7 @@ struct CpuLoad {
 impl CpuLoad {
     fn read() -> Option<(u64, u64, u64)> {
         let stat = std::fs::read_to_string("/proc/stat").ok()?;
-        let v: Vec<u64> = stat
-            .lines()
-            .next()?
-            .split_whitespace()
-            .skip(1)
-            .filter_map(|x| x.parse().ok())
-            .collect();
+        let v: Vec<u64> = stat.lines().next()?.split_whitespace().skip(1).filter_map(|x| x.parse().ok()).collect();
         let total: u64 = v.iter().sum();
         let busy = total - v.get(3)? - v.get(4)?;
         let own_stat = std::fs::read_to_string("/proc/self/stat").ok()?;
@@ -249,9 +222,7 @@ impl CpuLoad {
 
     /// CPU seconds (user + system, all threads) this process used since `start`.
     fn own_cpu_s(&self) -> f64 {
-        Self::read().map_or(f64::NAN, |(_, _, own)| {
-            (own - self.own) as f64 / CLOCK_TICKS_PER_S
-        })
+        Self::read().map_or(f64::NAN, |(_, _, own)| (own - self.own) as f64 / CLOCK_TICKS_PER_S)
     }
 
     fn other_cpus(&self) -> f64 {
@@ -266,9 +237,7 @@ impl CpuLoad {
 
 fn machine() -> Value {
     let cpu = std::fs::read_to_string("/proc/cpuinfo").ok().and_then(|s| {
-        s.lines()
-            .find(|l| l.starts_with("model name"))
-            .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_owned())
+        s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_owned())
     });
     json!({ "cpu_model": cpu, "cpus": std::thread::available_parallelism().map_or(1, |n| n.get()) })
 }
@@ -279,33 +248,18 @@ fn run_peer(python: &Path, args: &Args) -> anyhow::Result<Value> {
     let results = std::env::temp_dir().join(format!("amber-peer-mpn-{}", std::process::id()));
     let status = Command::new(python)
         .arg(&args.peer_script)
-        .args([
-            "--sizes",
-            &args.nodes.to_string(),
-            "--variants",
-            "plain,pyg",
-            "--ckpt-sizes",
-            "",
-            "--self-loops",
-        ])
+        .args(["--sizes", &args.nodes.to_string(), "--variants", "plain,pyg", "--ckpt-sizes", "", "--self-loops"])
         .args(["--steps", &args.iters.to_string()])
         .env("PEERS_RESULTS", &results)
         .env("PEERS_THREADS", args.peer_threads.to_string())
         .env("PEERS_OMP_WAIT_POLICY", "PASSIVE")
         .status()
-        .with_context(|| {
-            format!(
-                "running {} {}",
-                python.display(),
-                args.peer_script.display()
-            )
-        })?;
+        .with_context(|| format!("running {} {}", python.display(), args.peer_script.display()))?;
     if !status.success() {
         bail!("the peer benchmark failed: {status}");
     }
     let path = results.join("mpn.json");
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     std::fs::remove_dir_all(&results).ok();
     Ok(serde_json::from_str(&text)?)
 }

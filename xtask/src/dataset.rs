@@ -60,7 +60,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     let manifest = DatasetManifest::read(&args.manifest)?;
     if args.split != Split::Train && args.seed.is_some() {
-        bail!("--seed selects training problems; the {} split has a fixed seed in {}", args.split, args.manifest.display());
+        bail!(
+            "--seed selects training problems; the {} split has a fixed seed in {}",
+            args.split,
+            args.manifest.display()
+        );
     }
     let dir = split_dir(&args.out, args.difficulty, args.split, args.seed.unwrap_or(0));
     let (split_seed, size) = manifest.split(args.split, args.seed.unwrap_or(0), &args.manifest)?;

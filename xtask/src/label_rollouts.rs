@@ -61,11 +61,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let config = TrainingConfig::quick();
     let train = read_split(&args.train).with_context(|| missing(&args.train))?;
     let train = &train[..config.data.train_problems.min(train.len())];
-    let mut limits = MeshLimits::from_experts(
-        train.iter().map(|p| p.expert_mesh()),
-        config.budget_factor,
-        config.min_size_quantile,
-    );
+    let mut limits =
+        MeshLimits::from_experts(train.iter().map(|p| p.expert_mesh()), config.budget_factor, config.min_size_quantile);
     limits.scale_to_budget = true;
     let problems = read_split(&args.data).with_context(|| missing(&args.data))?;
     let rows = problems
@@ -96,7 +93,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let n = rows.len().max(1) as f64;
-    let per_step = |f: &dyn Fn(&Row, usize) -> f64| (0..args.steps).map(|t| rows.iter().map(|r| f(r, t)).sum::<f64>() / n).collect::<Vec<_>>();
+    let per_step = |f: &dyn Fn(&Row, usize) -> f64| {
+        (0..args.steps).map(|t| rows.iter().map(|r| f(r, t)).sum::<f64>() / n).collect::<Vec<_>>()
+    };
     let summary = serde_json::json!({
         "problems": rows.len(),
         "aggregation": args.aggregation,

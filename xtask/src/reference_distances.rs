@@ -34,7 +34,8 @@ struct Row {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let problems = read_split(&args.data).with_context(|| format!("{}: run `cargo xtask dataset poisson` first", args.data.display()))?;
+    let problems = read_split(&args.data)
+        .with_context(|| format!("{}: run `cargo xtask dataset poisson` first", args.data.display()))?;
     let rows = problems
         .par_iter()
         .enumerate()
@@ -59,5 +60,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "reconstruction_over_expert_elements_mean": mean(|r| r.reconstruction_elements as f64 / r.expert_elements as f64),
     });
     println!("{}", serde_json::to_string_pretty(&summary)?);
-    write_json(&args.out, &serde_json::json!({ "data": args.data, "summary": summary, "machine": machine(), "problems": rows }))
+    write_json(
+        &args.out,
+        &serde_json::json!({ "data": args.data, "summary": summary, "machine": machine(), "problems": rows }),
+    )
 }

@@ -54,7 +54,11 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn mesh_with<F: SizingField<2>>(domain: &PolygonDomain, field: &F, params: &Mesh2dParams) -> anyhow::Result<(Mesh2, QualityReport)> {
+fn mesh_with<F: SizingField<2>>(
+    domain: &PolygonDomain,
+    field: &F,
+    params: &Mesh2dParams,
+) -> anyhow::Result<(Mesh2, QualityReport)> {
     let mesh = generate_2d(domain, field, params).context("mesh generation failed")?;
     let report = QualityReport::measure(&mesh, field);
     Ok((mesh, report))
@@ -83,7 +87,12 @@ fn read_sizing_mesh(path: &Path) -> anyhow::Result<(Mesh2, Vec<f64>)> {
         .with_context(|| format!("--size {}: not a number and not a readable mesh", path.display()))?;
     let sizes = data.cell.get("size").cloned().unwrap_or_else(|| mesh.sizes());
     if sizes.len() != mesh.num_elements() {
-        bail!("{}: the `size` cell array has {} values for {} elements", path.display(), sizes.len(), mesh.num_elements());
+        bail!(
+            "{}: the `size` cell array has {} values for {} elements",
+            path.display(),
+            sizes.len(),
+            mesh.num_elements()
+        );
     }
     Ok((mesh, sizes))
 }

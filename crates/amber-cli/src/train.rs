@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use amber_experiments::{Method, read_json, merge_json, train_poisson};
+use amber_experiments::{Method, merge_json, read_json, train_poisson};
 use amber_mesh::{MeshData, RenderOptions, render_png, write_mesh};
 use amber_tasks::poisson::{Difficulty, read_problem};
 use amber_train::{AmberModel, Evaluation, MODEL_DIR, Profile, StepStatus, TrainingConfig};
@@ -89,14 +89,19 @@ pub struct GenerateArgs {
 }
 
 pub fn generate(args: GenerateArgs) -> anyhow::Result<()> {
-    let model = AmberModel::load(&args.model).with_context(|| format!("{}: cannot load the model", args.model.display()))?;
+    let model =
+        AmberModel::load(&args.model).with_context(|| format!("{}: cannot load the model", args.model.display()))?;
     let problem = read_problem(&args.problem)?;
     let problems = [problem];
     let evaluation = Evaluation::new(&problems, &model.predictor.limits)?;
     let (rollouts, summary) = evaluation.run(&model.network, &model.predictor, args.steps)?;
     let rollout = &rollouts[0];
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
-    let range = rollout.steps.iter().flat_map(|s| s.mesh.sizes()).fold((f64::INFINITY, 0.0f64), |(lo, hi), h| (lo.min(h), hi.max(h)));
+    let range = rollout
+        .steps
+        .iter()
+        .flat_map(|s| s.mesh.sizes())
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), h| (lo.min(h), hi.max(h)));
     for (t, step) in rollout.steps.iter().enumerate() {
         let sizes = step.mesh.sizes();
         let mut data = MeshData::default();

@@ -18,7 +18,8 @@ fn meshes_an_lshape_and_remeshes_from_the_result() {
 
     // The first mesh's element sizes as the field: the second mesh has about as many elements.
     let second = dir.path().join("second.msh");
-    let status = amber().args(["mesh", "--corner", "0.3,0.6", "--size"]).arg(&first).arg("-o").arg(&second).status().unwrap();
+    let status =
+        amber().args(["mesh", "--corner", "0.3,0.6", "--size"]).arg(&first).arg("-o").arg(&second).status().unwrap();
     assert!(status.success());
     let remeshed = amber_mesh::read_mesh::<2>(&second).unwrap();
     let ratio = remeshed.num_elements() as f64 / mesh.num_elements() as f64;
@@ -33,7 +34,12 @@ fn meshes_an_lshape_and_remeshes_from_the_result() {
 fn bad_input_fails_with_a_message_not_a_panic() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.vtu");
-    for args in [vec!["mesh", "--size", "-1"], vec!["mesh", "--size", "nan"], vec!["mesh", "--size", "/nonexistent.vtu"], vec!["mesh", "--corner", "1.5,0.5", "--size", "0.1"]] {
+    for args in [
+        vec!["mesh", "--size", "-1"],
+        vec!["mesh", "--size", "nan"],
+        vec!["mesh", "--size", "/nonexistent.vtu"],
+        vec!["mesh", "--corner", "1.5,0.5", "--size", "0.1"],
+    ] {
         let output = amber().args(&args).arg("-o").arg(&out).output().unwrap();
         assert!(!output.status.success(), "{args:?} succeeded");
         let stderr = String::from_utf8_lossy(&output.stderr);

@@ -6,9 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use amber_mesh::{Mesh3, View};
-use amber_tasks::console::{
-    ConsoleProblem, ConsoleSplit, INITIAL_MESH_RECIPE, TrainSet, has_test_split, part_names,
-};
+use amber_tasks::console::{ConsoleProblem, ConsoleSplit, INITIAL_MESH_RECIPE, TrainSet, has_test_split, part_names};
 use amber_train::{CnnConfig, Profile, TrainingConfig};
 use anyhow::bail;
 use rayon::prelude::*;
@@ -127,7 +125,8 @@ impl ConsoleExperiment {
         }
         let test_split = if has_test_split(&self.data) { ConsoleSplit::Test } else { ConsoleSplit::Val };
         let test = self.load(test_split, usize::MAX)?;
-        let test_name = evaluation_name(format!("console {} ({} parts)", test_split.name(), test.len()), self.scale_to_budget);
+        let test_name =
+            evaluation_name(format!("console {} ({} parts)", test_split.name(), test.len()), self.scale_to_budget);
         let mut runs = Vec::new();
         let mut configs = Vec::new();
         let mut rows: Vec<(String, Vec<Vec<Mesh3>>)> = Vec::new();
@@ -142,15 +141,21 @@ impl ConsoleExperiment {
                 );
                 let run =
                     Run::new(&self.runs_root, "console", "console", spec, &config, data_key, &test_name, self.force)?;
-                let evaluated = run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| match &config {
-                    RunConfig::Amber(c) => {
-                        let problems = || {
-                            Ok((self.load(ConsoleSplit::Train, c.data.train_problems)?, self.load(ConsoleSplit::Val, c.data.val_problems)?))
-                        };
-                        train_amber(c, problems, dir, label)
-                    }
-                    RunConfig::Cnn(c) => train_cnn(c, || self.load(ConsoleSplit::Train, c.data.train_problems), dir, label),
-                })?;
+                let evaluated =
+                    run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| match &config {
+                        RunConfig::Amber(c) => {
+                            let problems = || {
+                                Ok((
+                                    self.load(ConsoleSplit::Train, c.data.train_problems)?,
+                                    self.load(ConsoleSplit::Val, c.data.val_problems)?,
+                                ))
+                            };
+                            train_amber(c, problems, dir, label)
+                        }
+                        RunConfig::Cnn(c) => {
+                            train_cnn(c, || self.load(ConsoleSplit::Train, c.data.train_problems), dir, label)
+                        }
+                    })?;
                 configs.push(serde_json::json!({
                     "method": spec.method, "variant": spec.variant.name, "seed": seed, "run_dir": run.dir,
                     "training": config.to_json()?,

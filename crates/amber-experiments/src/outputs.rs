@@ -70,7 +70,8 @@ pub(crate) fn write_outputs(
             })
             .collect();
         // A task with a single setting (Console) is named once.
-        let title = if s.name == results.experiment { s.name.clone() } else { format!("{} {}", results.experiment, s.name) };
+        let title =
+            if s.name == results.experiment { s.name.clone() } else { format!("{} {}", results.experiment, s.name) };
         line_chart(
             &out.join(format!("ndcd_per_step_{}.png", s.name)),
             &format!("{title}: normalised DCD per generation step (step 0 = M⁰)"),

@@ -101,7 +101,10 @@ pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec
                 chart.draw_series(std::iter::once(rect)).map_err(plot_error)?;
                 chart
                     .draw_series(std::iter::once(PathElement::new(
-                        vec![(SegmentValue::CenterOf(i), bar.quantiles[0]), (SegmentValue::CenterOf(i), bar.quantiles[1])],
+                        vec![
+                            (SegmentValue::CenterOf(i), bar.quantiles[0]),
+                            (SegmentValue::CenterOf(i), bar.quantiles[1]),
+                        ],
                         BLACK.stroke_width(2),
                     )))
                     .map_err(plot_error)?;
@@ -155,9 +158,7 @@ pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series
                 .map_err(plot_error)?
                 .label(s.label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3)));
-            chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, 5, colour.filled())))
-                .map_err(plot_error)?;
+            chart.draw_series(s.points.iter().map(|&p| Circle::new(p, 5, colour.filled()))).map_err(plot_error)?;
         }
         chart
             .configure_series_labels()
@@ -188,7 +189,8 @@ pub enum TileMesh<'m> {
 /// A grid of mesh pictures (rows of tiles), every tile on the same logarithmic colour range so
 /// the pictures compare.
 pub fn mesh_gallery(path: &Path, rows: &[Vec<Tile<'_>>], tile: (u32, u32)) -> anyhow::Result<()> {
-    let positive = || rows.iter().flatten().flat_map(|t| t.values.iter().copied()).filter(|v| *v > 0.0 && v.is_finite());
+    let positive =
+        || rows.iter().flatten().flat_map(|t| t.values.iter().copied()).filter(|v| *v > 0.0 && v.is_finite());
     let range = (positive().fold(f64::INFINITY, f64::min), positive().fold(0.0, f64::max));
     let columns = rows.iter().map(Vec::len).max().unwrap_or(0) as u32;
     let (width, height) = (tile.0 * columns.max(1), tile.1 * rows.len().max(1) as u32);

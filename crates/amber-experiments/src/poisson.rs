@@ -116,7 +116,11 @@ impl PoissonExperiment {
             MethodSpec::plain(Method::AmberMax),
             variant(Method::AmberMean, "log-loss", log_loss.clone()),
             variant(Method::AmberMax, "log-loss", log_loss),
-            variant(Method::AmberMax, "no-softplus", serde_json::json!({ "objective": "linear", "normalise_labels": false })),
+            variant(
+                Method::AmberMax,
+                "no-softplus",
+                serde_json::json!({ "objective": "linear", "normalise_labels": false }),
+            ),
             variant(Method::AmberMax, "random-buffer", serde_json::json!({ "source_selection": "uniform" })),
             variant(Method::AmberMax, "no-input-normalisation", serde_json::json!({ "normalise_inputs": false })),
             variant(Method::AmberMean, "graph-context", serde_json::json!({ "network": { "graph_context": true } })),
@@ -195,13 +199,14 @@ impl PoissonExperiment {
                         &test_name,
                         self.force,
                     )?;
-                    let evaluated = run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| match &config {
-                        RunConfig::Amber(c) => train_poisson(c, &self.data_root, &self.manifest, dir, label),
-                        RunConfig::Cnn(c) => {
-                            let train = || self.load(difficulty, Split::Train, seed, c.data.train_problems);
-                            train_cnn(c, train, dir, label)
-                        }
-                    })?;
+                    let evaluated =
+                        run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| match &config {
+                            RunConfig::Amber(c) => train_poisson(c, &self.data_root, &self.manifest, dir, label),
+                            RunConfig::Cnn(c) => {
+                                let train = || self.load(difficulty, Split::Train, seed, c.data.train_problems);
+                                train_cnn(c, train, dir, label)
+                            }
+                        })?;
                     configs.push(serde_json::json!({
                         "method": spec.method, "variant": spec.variant.name, "difficulty": difficulty.name(),
                         "seed": seed, "run_dir": run.dir, "training": config.to_json()?,
@@ -240,7 +245,13 @@ impl PoissonExperiment {
     }
 
     /// The first `count` problems of a split, generated first where missing.
-    fn load(&self, difficulty: Difficulty, split: Split, seed: usize, count: usize) -> anyhow::Result<Vec<PoissonProblem>> {
+    fn load(
+        &self,
+        difficulty: Difficulty,
+        split: Split,
+        seed: usize,
+        count: usize,
+    ) -> anyhow::Result<Vec<PoissonProblem>> {
         load_problems(&self.data_root, &self.manifest, difficulty, split, seed, count)
     }
 

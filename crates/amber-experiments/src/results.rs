@@ -184,13 +184,20 @@ mod tests {
                 metrics: metrics(v),
             })
             .collect();
-        ProblemEvaluation { initial: metrics(1.0), steps, initial_dcd: 0.5, reconstruction_dcd: 0.2, expert_elements: 20 }
+        ProblemEvaluation {
+            initial: metrics(1.0),
+            steps,
+            initial_dcd: 0.5,
+            reconstruction_dcd: 0.2,
+            expert_elements: 20,
+        }
     }
 
     #[test]
     fn runs_reduce_to_means_quantiles_and_failure_counts() {
         let problems = [evaluation(&[0.8, 0.4], false), evaluation(&[0.6, 0.2], true), evaluation(&[0.7, 0.3], false)];
-        let key = RunKey { method: "m", variant: "v", difficulty: "hard", seed: 0, train_seconds: 1.0, eval_seconds: 2.0 };
+        let key =
+            RunKey { method: "m", variant: "v", difficulty: "hard", seed: 0, train_seconds: 1.0, eval_seconds: 2.0 };
         let run = RunResult::new(key, &problems);
         assert!((run.ndcd - 0.3).abs() < 1e-12);
         assert!((run.ndcd_per_step[0] - 0.7).abs() < 1e-12 && (run.ndcd_per_step[1] - 0.3).abs() < 1e-12);
@@ -209,7 +216,10 @@ mod tests {
             config,
             runs: Vec::new(),
         };
-        assert_eq!(results(serde_json::json!({ "test_split": "val" })).evaluated_on(), "the val problems (no test split)");
+        assert_eq!(
+            results(serde_json::json!({ "test_split": "val" })).evaluated_on(),
+            "the val problems (no test split)"
+        );
         assert_eq!(results(serde_json::json!({ "test_split": "test" })).evaluated_on(), "the test problems");
         assert_eq!(results(serde_json::json!({})).evaluated_on(), "the test problems");
     }

@@ -120,11 +120,8 @@ impl Run {
         };
         let mut key = serde_json::json!({ "config": config.untagged()? });
         key[data_key.0] = data_key.1;
-        let dir = runs_root
-            .join(task)
-            .join(setting)
-            .join(&name)
-            .join(format!("seed{}-{}", config.seed(), config_hash(&key)));
+        let dir =
+            runs_root.join(task).join(setting).join(&name).join(format!("seed{}-{}", config.seed(), config_hash(&key)));
         if force && dir.exists() {
             std::fs::remove_dir_all(&dir).with_context(|| format!("{}: cannot remove for --force", dir.display()))?;
         }
@@ -168,11 +165,8 @@ impl Run {
             }
         };
         let eval_seconds = started.elapsed().as_secs_f64();
-        let problems: Vec<ProblemEvaluation> = rollouts
-            .iter()
-            .zip(test)
-            .map(|(r, p)| ProblemEvaluation::of(r, p.expert_mesh().num_elements()))
-            .collect();
+        let problems: Vec<ProblemEvaluation> =
+            rollouts.iter().zip(test).map(|(r, p)| ProblemEvaluation::of(r, p.expert_mesh().num_elements())).collect();
         self.save_gallery_meshes(&rollouts)?;
         let summary = EvaluationSummary::new(test, &rollouts);
         println!(
@@ -283,7 +277,10 @@ fn finished_run<C: PartialEq + serde::de::DeserializeOwned>(dir: &Path, config: 
         return Ok(None);
     }
     if read_json::<C>(&dir.join(CONFIG_FILE))? != *config {
-        bail!("{}: holds a finished run with another configuration; train into a new directory or delete it", dir.display());
+        bail!(
+            "{}: holds a finished run with another configuration; train into a new directory or delete it",
+            dir.display()
+        );
     }
     Ok(Some(time.seconds))
 }

@@ -129,11 +129,7 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
             );
         }
     }
-    let _ = writeln!(
-        md,
-        "\nCommit `{}`; machine: {}.",
-        results.commit.as_deref().unwrap_or("unknown"),
-        results.machine
-    );
+    let _ =
+        writeln!(md, "\nCommit `{}`; machine: {}.", results.commit.as_deref().unwrap_or("unknown"), results.machine);
     md
 }

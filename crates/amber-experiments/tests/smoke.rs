@@ -34,8 +34,21 @@ fn smoke_profile_writes_every_output_and_reuses_its_runs() {
     let runs = value["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 3, "AMBER-Mean, AMBER-Max and the 32² CNN on easy, one seed");
     let fields = [
-        "method", "variant", "difficulty", "seed", "ndcd", "ndcd_quantiles", "ndcd_per_step", "dcd", "dcd_initial",
-        "dcd_reconstruction", "volume_difference", "elements", "expert_elements", "failed_steps", "train_seconds",
+        "method",
+        "variant",
+        "difficulty",
+        "seed",
+        "ndcd",
+        "ndcd_quantiles",
+        "ndcd_per_step",
+        "dcd",
+        "dcd_initial",
+        "dcd_reconstruction",
+        "volume_difference",
+        "elements",
+        "expert_elements",
+        "failed_steps",
+        "train_seconds",
         "eval_seconds",
     ];
     let steps = amber_train::TrainingConfig::smoke().inference_steps;
@@ -155,7 +168,14 @@ fn console_smoke_trains_evaluates_on_val_and_draws_surfaces() {
         assert!((0.6..0.95).contains(&run.dcd_initial) && (0.35..0.6).contains(&run.dcd_reconstruction), "{run:?}");
         assert!(run.ndcd.is_finite());
     }
-    for file in ["results.json", "table.md", "ndcd_bars.png", "ndcd_per_step_console.png", "gallery_console_view1.png", "gallery_console_view2.png"] {
+    for file in [
+        "results.json",
+        "table.md",
+        "ndcd_bars.png",
+        "ndcd_per_step_console.png",
+        "gallery_console_view1.png",
+        "gallery_console_view2.png",
+    ] {
         assert!(experiment.out.join(file).exists(), "{file} missing");
     }
     // Two methods × two parts; steps 1, 2, T and the expert.

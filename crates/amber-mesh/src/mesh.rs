@@ -159,7 +159,8 @@ pub fn signed_volume<const D: usize>(vertices: &[[f64; D]], cell: &[u32]) -> f64
     match D {
         2 => 0.5 * (d(1, 0) * d(2, 1) - d(1, 1) * d(2, 0)),
         3 => {
-            let det = d(1, 0) * (d(2, 1) * d(3, 2) - d(2, 2) * d(3, 1)) - d(1, 1) * (d(2, 0) * d(3, 2) - d(2, 2) * d(3, 0))
+            let det = d(1, 0) * (d(2, 1) * d(3, 2) - d(2, 2) * d(3, 1))
+                - d(1, 1) * (d(2, 0) * d(3, 2) - d(2, 2) * d(3, 0))
                 + d(1, 2) * (d(2, 0) * d(3, 1) - d(2, 1) * d(3, 0));
             det / 6.0
         }
@@ -214,9 +215,7 @@ fn angle_between<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
 }
 
 fn min_triangle_angle<const D: usize>(p: &[[f64; D]]) -> f64 {
-    (0..3)
-        .map(|i| angle_between(sub(p[(i + 1) % 3], p[i]), sub(p[(i + 2) % 3], p[i])))
-        .fold(f64::INFINITY, f64::min)
+    (0..3).map(|i| angle_between(sub(p[(i + 1) % 3], p[i]), sub(p[(i + 2) % 3], p[i]))).fold(f64::INFINITY, f64::min)
 }
 
 fn min_dihedral_angle<const D: usize>(p: &[[f64; D]]) -> f64 {

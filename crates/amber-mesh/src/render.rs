@@ -111,7 +111,8 @@ pub fn render_png(
             expected: mesh.num_elements(),
         });
     }
-    let image = render_rgb(mesh, values, options).map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
+    let image =
+        render_rgb(mesh, values, options).map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
     write_png(path, options.width, options.height, &image)
 }
 
@@ -139,7 +140,12 @@ pub struct View {
 /// The picture of a tetrahedral mesh's boundary surface seen from `view`, each boundary
 /// triangle coloured by its tetrahedron's value and shaded by its angle to the light, as
 /// row-major RGB bytes (see [`render_rgb`]).
-pub fn render_surface_rgb(mesh: &Mesh3, values: &[f64], options: &RenderOptions, view: View) -> Result<Vec<u8>, String> {
+pub fn render_surface_rgb(
+    mesh: &Mesh3,
+    values: &[f64],
+    options: &RenderOptions,
+    view: View,
+) -> Result<Vec<u8>, String> {
     if values.len() != mesh.num_elements() {
         return Err(format!("{} rendered values for {} elements", values.len(), mesh.num_elements()));
     }
@@ -172,7 +178,11 @@ fn visible_surface(mesh: &Mesh3, values: &[f64], view: View) -> Result<(Mesh2, V
     let eye = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
     let right = [-az.sin(), az.cos(), 0.0];
     let up = cross(eye, right);
-    let light = normalised([eye[0] + 0.4 * up[0] + 0.3 * right[0], eye[1] + 0.4 * up[1] + 0.3 * right[1], eye[2] + 0.4 * up[2] + 0.3 * right[2]]);
+    let light = normalised([
+        eye[0] + 0.4 * up[0] + 0.3 * right[0],
+        eye[1] + 0.4 * up[1] + 0.3 * right[1],
+        eye[2] + 0.4 * up[2] + 0.3 * right[2],
+    ]);
     let adjacency = FacetAdjacency::new(mesh).map_err(|e| e.to_string())?;
     let vertices = mesh.vertices();
     let mut faces: Vec<(f64, [u32; 3], f64, f64)> = Vec::new();

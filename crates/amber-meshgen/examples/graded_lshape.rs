@@ -6,7 +6,9 @@ use amber_meshgen::{FnSize, Mesh2dParams, PolygonDomain, QualityReport, generate
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scale: f64 = std::env::args().nth(1).map(|s| s.parse()).transpose()?.unwrap_or(1.0);
     let domain = PolygonDomain::lshape([0.5, 0.5])?;
-    let field = FnSize(move |x: [f64; 2]| scale * (0.003 + 0.3 * ((x[0] - 0.5).powi(2) + (x[1] - 0.5).powi(2)).sqrt()).min(0.1));
+    let field = FnSize(move |x: [f64; 2]| {
+        scale * (0.003 + 0.3 * ((x[0] - 0.5).powi(2) + (x[1] - 0.5).powi(2)).sqrt()).min(0.1)
+    });
     let start = std::time::Instant::now();
     let mesh = generate_2d(&domain, &field, &Mesh2dParams::default())?;
     let seconds = start.elapsed().as_secs_f64();

@@ -124,7 +124,13 @@ impl PolygonDomain {
             .rings()
             .enumerate()
             .flat_map(|(ring, pts)| {
-                (0..pts.len()).map(move |index| Edge { ring, index, ring_len: pts.len(), a: pts[index], b: pts[(index + 1) % pts.len()] })
+                (0..pts.len()).map(move |index| Edge {
+                    ring,
+                    index,
+                    ring_len: pts.len(),
+                    a: pts[index],
+                    b: pts[(index + 1) % pts.len()],
+                })
             })
             .collect();
         edges.sort_by(|e, f| e.a[0].min(e.b[0]).total_cmp(&f.a[0].min(f.b[0])));
@@ -137,9 +143,18 @@ impl PolygonDomain {
                 }
                 let adjacent = e.ring == f.ring
                     && ((e.index + 1) % e.ring_len == f.index || (f.index + 1) % f.ring_len == e.index);
-                let hit = if adjacent { segments_overlap_beyond_shared_vertex(e, f) } else { segments_intersect(e.a, e.b, f.a, f.b) };
+                let hit = if adjacent {
+                    segments_overlap_beyond_shared_vertex(e, f)
+                } else {
+                    segments_intersect(e.a, e.b, f.a, f.b)
+                };
                 if hit {
-                    return Err(MeshgenError::SelfIntersecting { ring_a: e.ring, edge_a: e.index, ring_b: f.ring, edge_b: f.index });
+                    return Err(MeshgenError::SelfIntersecting {
+                        ring_a: e.ring,
+                        edge_a: e.index,
+                        ring_b: f.ring,
+                        edge_b: f.index,
+                    });
                 }
             }
         }
@@ -220,7 +235,10 @@ mod tests {
         let outside_hole = vec![[2.0, 2.0], [3.0, 2.0], [3.0, 3.0]];
         assert!(PolygonDomain::new(square.clone(), vec![outside_hole]).is_err());
         let crossing_hole = vec![[0.5, 0.5], [1.5, 0.5], [0.5, 0.7]];
-        assert!(matches!(PolygonDomain::new(square.clone(), vec![crossing_hole]), Err(MeshgenError::SelfIntersecting { .. })));
+        assert!(matches!(
+            PolygonDomain::new(square.clone(), vec![crossing_hole]),
+            Err(MeshgenError::SelfIntersecting { .. })
+        ));
         let hole = vec![[0.25, 0.25], [0.75, 0.25], [0.75, 0.75], [0.25, 0.75]];
         let d = PolygonDomain::new(square, vec![hole]).unwrap();
         assert!((d.area() - 0.75).abs() < 1e-15);

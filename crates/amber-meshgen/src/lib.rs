@@ -14,7 +14,9 @@ pub use domain::PolygonDomain;
 pub use error::MeshgenError;
 pub use mesh2d::{Mesh2dParams, generate_2d, uniform_mesh_2d};
 pub use quality::{QualityReport, quantile};
-pub use sizing::{ClampedSize, ConstantSize, FnSize, MeshSizing, PixelGridSizing, SizingField, estimated_element_count};
+pub use sizing::{
+    ClampedSize, ConstantSize, FnSize, MeshSizing, PixelGridSizing, SizingField, estimated_element_count,
+};
 
-pub mod rgb;
 pub mod mesh3d;
+pub mod rgb;

@@ -13,7 +13,10 @@ use std::collections::VecDeque;
 
 use amber_mesh::Mesh2;
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
-use spade::{ConstrainedDelaunayTriangulation, Intersection, LineIntersectionIterator, Point2, PositionInTriangulation, Triangulation};
+use spade::{
+    ConstrainedDelaunayTriangulation, Intersection, LineIntersectionIterator, Point2, PositionInTriangulation,
+    Triangulation,
+};
 
 use crate::{ConstantSize, MeshgenError, PolygonDomain, SizingField};
 
@@ -41,7 +44,13 @@ pub struct Mesh2dParams {
 
 impl Default for Mesh2dParams {
     fn default() -> Self {
-        Self { max_elements: 5_000_000, size_factor: 0.78, min_angle_deg: 25.0, quality_floor: 0.5, smoothing_passes: 2 }
+        Self {
+            max_elements: 5_000_000,
+            size_factor: 0.78,
+            min_angle_deg: 25.0,
+            quality_floor: 0.5,
+            smoothing_passes: 2,
+        }
     }
 }
 
@@ -204,7 +213,8 @@ fn refine(
     params: &Mesh2dParams,
 ) -> Result<Vec<u8>, MeshgenError> {
     let mut side = classify_faces(cdt);
-    let mut vertex_size = cdt.vertices().map(|v| size([v.position().x, v.position().y])).collect::<Result<Vec<_>, _>>()?;
+    let mut vertex_size =
+        cdt.vertices().map(|v| size([v.position().x, v.position().y])).collect::<Result<Vec<_>, _>>()?;
     let mut queue: VecDeque<FixedFaceHandle<InnerTag>> =
         cdt.fixed_inner_faces().filter(|f| side[f.index()] == INSIDE).collect();
     let shape_limit = 1.0 / (2.0 * params.min_angle_deg.to_radians().sin());
@@ -244,7 +254,9 @@ fn refine(
                 // its circumcentre.
                 let from = Point2::new(centroid[0], centroid[1]);
                 let crossed = LineIntersectionIterator::new(cdt, from, target).find_map(|i| match i {
-                    Intersection::EdgeIntersection(e) | Intersection::EdgeOverlap(e) if e.is_constraint_edge() => Some(e.fix()),
+                    Intersection::EdgeIntersection(e) | Intersection::EdgeOverlap(e) if e.is_constraint_edge() => {
+                        Some(e.fix())
+                    }
                     _ => None,
                 });
                 match crossed {
@@ -261,7 +273,9 @@ fn refine(
                 // Only split where the midpoint lies exactly on the segment, or spade would
                 // leave the segment whole beside a new vertex.
                 match cdt.locate_with_hint(midpoint, segment.from().fix()) {
-                    PositionInTriangulation::OnEdge(e) if e.as_undirected() == segment.fix().as_undirected() => Some(midpoint),
+                    PositionInTriangulation::OnEdge(e) if e.as_undirected() == segment.fix().as_undirected() => {
+                        Some(midpoint)
+                    }
                     _ => None,
                 }
             }
@@ -500,7 +514,8 @@ mod tests {
         let mut boundary_length = 0.0;
         for (e, local) in adjacency.boundary_facets() {
             let cell = mesh.element(e);
-            let (p, q) = (mesh.vertices()[cell[(local + 1) % 3] as usize], mesh.vertices()[cell[(local + 2) % 3] as usize]);
+            let (p, q) =
+                (mesh.vertices()[cell[(local + 1) % 3] as usize], mesh.vertices()[cell[(local + 2) % 3] as usize]);
             assert!(on_domain_edge(p, q), "boundary edge {p:?}-{q:?} is not on the domain boundary");
             boundary_length += dist2(p, q).sqrt();
         }
@@ -512,14 +527,16 @@ mod tests {
     /// A star-shaped polygon: vertices at sorted angles with random radii.
     fn star_polygon() -> impl Strategy<Value = Vec<[f64; 2]>> {
         (5usize..12).prop_flat_map(|n| {
-            (proptest::collection::vec(0.0..1.0f64, n), proptest::collection::vec(0.4..1.0f64, n)).prop_map(move |(jitter, radii)| {
-                (0..n)
-                    .map(|i| {
-                        let angle = (i as f64 + 0.8 * jitter[i]) * std::f64::consts::TAU / n as f64;
-                        [radii[i] * angle.cos(), radii[i] * angle.sin()]
-                    })
-                    .collect()
-            })
+            (proptest::collection::vec(0.0..1.0f64, n), proptest::collection::vec(0.4..1.0f64, n)).prop_map(
+                move |(jitter, radii)| {
+                    (0..n)
+                        .map(|i| {
+                            let angle = (i as f64 + 0.8 * jitter[i]) * std::f64::consts::TAU / n as f64;
+                            [radii[i] * angle.cos(), radii[i] * angle.sin()]
+                        })
+                        .collect()
+                },
+            )
         })
     }
 
@@ -585,7 +602,10 @@ mod tests {
         }
         // NaN only in part of the domain is caught too.
         let patchy = FnSize(|x: [f64; 2]| if x[0] > 0.25 && x[1] < 0.25 { f64::NAN } else { 0.05 });
-        assert!(matches!(generate_2d(&domain, &patchy, &Mesh2dParams::default()), Err(MeshgenError::InvalidSize { .. })));
+        assert!(matches!(
+            generate_2d(&domain, &patchy, &Mesh2dParams::default()),
+            Err(MeshgenError::InvalidSize { .. })
+        ));
     }
 
     #[test]

@@ -128,7 +128,12 @@ mod tests {
 
     #[test]
     fn pixel_grid_uses_the_nearest_pixel_and_clamps_to_the_border() {
-        let g = PixelGridSizing { origin: [0.0, 0.0], spacing: [0.5, 0.5], shape: [2, 2], values: vec![1.0, 2.0, 3.0, 4.0] };
+        let g = PixelGridSizing {
+            origin: [0.0, 0.0],
+            spacing: [0.5, 0.5],
+            shape: [2, 2],
+            values: vec![1.0, 2.0, 3.0, 4.0],
+        };
         assert_eq!(g.size_at([0.1, 0.1]), 1.0);
         assert_eq!(g.size_at([0.1, 0.9]), 2.0);
         assert_eq!(g.size_at([0.9, 0.1]), 3.0);

@@ -65,12 +65,7 @@ impl MpnConfig {
 
     /// The reference code's Console network: 1 node feature, 3 edge features, D = 128.
     pub fn console() -> Self {
-        Self {
-            node_features: 1,
-            edge_features: 3,
-            latent_dim: 128,
-            ..Self::poisson()
-        }
+        Self { node_features: 1, edge_features: 3, latent_dim: 128, ..Self::poisson() }
     }
 
     pub fn validate(&self) -> Result<()> {
@@ -90,8 +85,7 @@ impl MpnConfig {
         let d = self.latent_dim;
         let linear = |i: usize, o: usize| i * o + o;
         let context = if self.graph_context { linear(d, d) } else { 0 };
-        let step =
-            linear(3 * d, d) + linear(d, d) + linear(2 * d, d) + linear(d, d) + 2 * 2 * d + context;
+        let step = linear(3 * d, d) + linear(d, d) + linear(2 * d, d) + linear(d, d) + 2 * 2 * d + context;
         linear(self.node_features, d)
             + linear(self.edge_features, d)
             + self.steps * step
@@ -115,32 +109,14 @@ mod tests {
 
     #[test]
     fn json_round_trip_and_defaults() {
-        let c = MpnConfig {
-            output: OutputTransform::Exp,
-            ..MpnConfig::console()
-        };
+        let c = MpnConfig { output: OutputTransform::Exp, ..MpnConfig::console() };
         let back: MpnConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
         assert_eq!(back, c);
         assert!(!serde_json::to_string(&c).unwrap().contains("graph_context"));
         let on = MpnConfig { graph_context: true, ..c };
         assert_eq!(serde_json::from_str::<MpnConfig>(&serde_json::to_string(&on).unwrap()).unwrap(), on);
-        let partial: MpnConfig =
-            serde_json::from_str(r#"{"latent_dim": 32, "output": "none"}"#).unwrap();
-        assert_eq!(
-            partial,
-            MpnConfig {
-                latent_dim: 32,
-                output: OutputTransform::None,
-                ..MpnConfig::poisson()
-            }
-        );
-        assert!(
-            MpnConfig {
-                edge_dropout: 1.0,
-                ..MpnConfig::poisson()
-            }
-            .validate()
-            .is_err()
-        );
+        let partial: MpnConfig = serde_json::from_str(r#"{"latent_dim": 32, "output": "none"}"#).unwrap();
+        assert_eq!(partial, MpnConfig { latent_dim: 32, output: OutputTransform::None, ..MpnConfig::poisson() });
+        assert!(MpnConfig { edge_dropout: 1.0, ..MpnConfig::poisson() }.validate().is_err());
     }
 }

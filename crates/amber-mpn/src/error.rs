@@ -6,11 +6,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum MpnError {
     #[error("{what} has {got} features per row, the network expects {expected}")]
-    FeatureDim {
-        what: &'static str,
-        expected: usize,
-        got: usize,
-    },
+    FeatureDim { what: &'static str, expected: usize, got: usize },
     #[error("invalid graph: {0}")]
     InvalidGraph(String),
     #[error("invalid configuration: {0}")]
@@ -18,15 +14,9 @@ pub enum MpnError {
     #[error("checkpoint {}: {message}", .path.display())]
     Checkpoint { path: PathBuf, message: String },
     #[error("reading or writing {}: {source}", .path.display())]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     #[error("checkpoint config {}: {source}", .path.display())]
-    Json {
-        path: PathBuf,
-        source: serde_json::Error,
-    },
+    Json { path: PathBuf, source: serde_json::Error },
     #[error(transparent)]
     Candle(#[from] candle_core::Error),
 }

@@ -24,32 +24,16 @@ pub struct Topology {
 
 impl Topology {
     /// Checks that `dst` is sorted, `dst_offsets` is its CSR index and every endpoint exists.
-    pub fn new(
-        num_nodes: usize,
-        src: Vec<u32>,
-        dst: Vec<u32>,
-        dst_offsets: Vec<u32>,
-    ) -> Result<Self> {
+    pub fn new(num_nodes: usize, src: Vec<u32>, dst: Vec<u32>, dst_offsets: Vec<u32>) -> Result<Self> {
         let bad = |m: String| Err(MpnError::InvalidGraph(m));
         if num_nodes > u32::MAX as usize || src.len() > u32::MAX as usize {
             return bad("more than 2^32 nodes or edges".into());
         }
         if src.len() != dst.len() {
-            return bad(format!(
-                "{} edge sources but {} destinations",
-                src.len(),
-                dst.len()
-            ));
+            return bad(format!("{} edge sources but {} destinations", src.len(), dst.len()));
         }
-        if dst_offsets.len() != num_nodes + 1
-            || dst_offsets[0] != 0
-            || dst_offsets[num_nodes] as usize != dst.len()
-        {
-            return bad(format!(
-                "dst_offsets must have {} entries from 0 to {}",
-                num_nodes + 1,
-                dst.len()
-            ));
+        if dst_offsets.len() != num_nodes + 1 || dst_offsets[0] != 0 || dst_offsets[num_nodes] as usize != dst.len() {
+            return bad(format!("dst_offsets must have {} entries from 0 to {}", num_nodes + 1, dst.len()));
         }
         for v in 0..num_nodes {
             let (lo, hi) = (dst_offsets[v] as usize, dst_offsets[v + 1] as usize);
@@ -57,10 +41,7 @@ impl Topology {
                 return bad(format!("dst_offsets decreases at node {v}"));
             }
             if let Some(k) = (lo..hi).find(|&k| dst[k] as usize != v) {
-                return bad(format!(
-                    "edge {k} ends at node {} but lies in the segment of node {v}",
-                    dst[k]
-                ));
+                return bad(format!("edge {k} ends at node {} but lies in the segment of node {v}", dst[k]));
             }
         }
         if let Some(k) = src.iter().position(|&s| s as usize >= num_nodes) {
@@ -84,14 +65,7 @@ impl Topology {
             by_src[next[s as usize] as usize] = k as u32;
             next[s as usize] += 1;
         }
-        Self {
-            num_nodes,
-            src,
-            dst,
-            dst_offsets,
-            by_src,
-            src_offsets,
-        }
+        Self { num_nodes, src, dst, dst_offsets, by_src, src_offsets }
     }
 
     pub fn num_nodes(&self) -> usize {
@@ -121,9 +95,7 @@ impl Topology {
     /// (none for `p ≤ 0`, all for `p ≥ 1`); returns the remaining graph and the ids of the kept
     /// edges.
     pub fn drop_edges<R: Rng + ?Sized>(&self, p: f64, rng: &mut R) -> (Self, Vec<u32>) {
-        let kept: Vec<u32> = (0..self.num_edges() as u32)
-            .filter(|_| rng.random::<f64>() >= p)
-            .collect();
+        let kept: Vec<u32> = (0..self.num_edges() as u32).filter(|_| rng.random::<f64>() >= p).collect();
         let src = kept.iter().map(|&k| self.src[k as usize]).collect();
         let dst: Vec<u32> = kept.iter().map(|&k| self.dst[k as usize]).collect();
         let mut dst_offsets = vec![0u32; self.num_nodes + 1];
@@ -133,10 +105,7 @@ impl Topology {
         for v in 0..self.num_nodes {
             dst_offsets[v + 1] += dst_offsets[v];
         }
-        (
-            Self::from_sorted(self.num_nodes, src, dst, dst_offsets),
-            kept,
-        )
+        (Self::from_sorted(self.num_nodes, src, dst, dst_offsets), kept)
     }
 }
 
@@ -164,21 +133,12 @@ impl GraphInput {
             // Its mean node state would be 0/0, and a NaN reaches every context weight's gradient.
             return Err(MpnError::InvalidGraph(format!("graph {g} of the batch has no nodes")));
         }
-        let inverse_graph_sizes: Vec<f32> =
-            offsets.windows(2).map(|w| 1.0 / (w[1] - w[0]) as f32).collect();
+        let inverse_graph_sizes: Vec<f32> = offsets.windows(2).map(|w| 1.0 / (w[1] - w[0]) as f32).collect();
         let inverse_graph_sizes =
-            Tensor::from_vec(inverse_graph_sizes, (offsets.len() - 1, 1), device)?
-                .to_dtype(dtype)?;
-        let topology = Topology::new(
-            n,
-            batch.edge_src.clone(),
-            batch.edge_dst.clone(),
-            batch.dst_offsets.clone(),
-        )?;
-        let node_features = Tensor::from_slice(&batch.node_features, (n, batch.node_dim), device)?
-            .to_dtype(dtype)?;
-        let edge_features = Tensor::from_slice(&batch.edge_features, (e, batch.edge_dim), device)?
-            .to_dtype(dtype)?;
+            Tensor::from_vec(inverse_graph_sizes, (offsets.len() - 1, 1), device)?.to_dtype(dtype)?;
+        let topology = Topology::new(n, batch.edge_src.clone(), batch.edge_dst.clone(), batch.dst_offsets.clone())?;
+        let node_features = Tensor::from_slice(&batch.node_features, (n, batch.node_dim), device)?.to_dtype(dtype)?;
+        let edge_features = Tensor::from_slice(&batch.edge_features, (e, batch.edge_dim), device)?.to_dtype(dtype)?;
         Ok(Self {
             node_features,
             edge_features,
@@ -219,13 +179,7 @@ mod tests {
 
     /// 3 nodes, edges 1→0, 2→0, and self-loops.
     fn small() -> Topology {
-        Topology::new(
-            3,
-            vec![0, 1, 2, 1, 2],
-            vec![0, 0, 0, 1, 2],
-            vec![0, 3, 4, 5],
-        )
-        .unwrap()
+        Topology::new(3, vec![0, 1, 2, 1, 2], vec![0, 0, 0, 1, 2], vec![0, 3, 4, 5]).unwrap()
     }
 
     #[test]
@@ -251,12 +205,7 @@ mod tests {
         assert_eq!(kept, vec![0, 1, 2, 3, 4]);
         assert_eq!(none.dst_offsets(), t.dst_offsets());
         let (half, kept) = t.drop_edges(0.5, &mut rng);
-        let again = Topology::new(
-            3,
-            half.src().to_vec(),
-            half.dst().to_vec(),
-            half.dst_offsets().to_vec(),
-        );
+        let again = Topology::new(3, half.src().to_vec(), half.dst().to_vec(), half.dst_offsets().to_vec());
         assert!(again.is_ok());
         assert!(kept.windows(2).all(|w| w[0] < w[1]));
     }

@@ -64,10 +64,7 @@ pub(crate) fn matmul<T: Real>(
     out: &mut [T],
     accumulate: bool,
 ) {
-    assert!(
-        a.len() >= m * k && b.len() >= k * n && out.len() >= m * n,
-        "matmul operand too short"
-    );
+    assert!(a.len() >= m * k && b.len() >= k * n && out.len() >= m * n, "matmul operand too short");
     if m == 0 || n == 0 {
         return;
     }
@@ -101,21 +98,13 @@ pub(crate) fn matmul<T: Real>(
 
 #[inline]
 pub(crate) fn leaky_relu<T: Real>(v: T) -> T {
-    if v >= T::from_f64(0.0) {
-        v
-    } else {
-        v * T::from_f64(NEGATIVE_SLOPE)
-    }
+    if v >= T::from_f64(0.0) { v } else { v * T::from_f64(NEGATIVE_SLOPE) }
 }
 
 /// Derivative of LeakyReLU read off its output (the slope keeps the sign).
 #[inline]
 pub(crate) fn leaky_relu_slope<T: Real>(activation: T) -> T {
-    if activation >= T::from_f64(0.0) {
-        T::from_f64(1.0)
-    } else {
-        T::from_f64(NEGATIVE_SLOPE)
-    }
+    if activation >= T::from_f64(0.0) { T::from_f64(1.0) } else { T::from_f64(NEGATIVE_SLOPE) }
 }
 
 pub(crate) fn add_assign<T: Real>(acc: &mut [T], v: &[T]) {
@@ -189,14 +178,7 @@ pub(crate) struct MlpGrads<T> {
 impl<T: Real> MlpGrads<T> {
     pub fn zeros(in_dim: usize, d: usize) -> Self {
         let z = |n| vec![T::from_f64(0.0); n];
-        Self {
-            w1: z(in_dim * d),
-            b1: z(d),
-            w2: z(d * d),
-            b2: z(d),
-            gamma: z(d),
-            beta: z(d),
-        }
+        Self { w1: z(in_dim * d), b1: z(d), w2: z(d * d), b2: z(d), gamma: z(d), beta: z(d) }
     }
 
     pub fn merge(mut self, other: Self) -> Self {
@@ -296,18 +278,12 @@ fn sum<T: Real>(a: &[T]) -> T {
             acc[l] += x[l];
         }
     }
-    rest.iter()
-        .fold(acc.iter().fold(zero, |s, &v| s + v), |s, &v| s + v)
+    rest.iter().fold(acc.iter().fold(zero, |s, &v| s + v), |s, &v| s + v)
 }
 
 /// Finishes a residual MLP block on `rows` rows: `h1 = act(h1 + b1)`, `h2 = act(h1·W2 + b2)`,
 /// `out = LayerNorm(residual + h2)`.
-pub(crate) fn tail_forward<T: Real>(
-    w: &MlpWeights<T>,
-    residual: &[T],
-    st: TailState<'_, T>,
-    out: &mut [T],
-) {
+pub(crate) fn tail_forward<T: Real>(w: &MlpWeights<T>, residual: &[T], st: TailState<'_, T>, out: &mut [T]) {
     let d = w.d;
     let rows = residual.len() / d;
     bias_leaky_relu(st.h1, &w.b1);

@@ -27,10 +27,7 @@ struct Linear {
 impl Linear {
     fn new(vb: VarBuilder, in_dim: usize, out_dim: usize) -> candle_core::Result<Self> {
         let bound = 1.0 / (in_dim as f64).sqrt();
-        let init = Init::Uniform {
-            lo: -bound,
-            up: bound,
-        };
+        let init = Init::Uniform { lo: -bound, up: bound };
         Ok(Self {
             weight: vb.get_with_hints((out_dim, in_dim), "weight", init)?,
             bias: vb.get_with_hints(out_dim, "bias", init)?,
@@ -67,10 +64,7 @@ impl ResidualMlp {
     fn new(vb: VarBuilder, in_dim: usize, d: usize) -> candle_core::Result<Self> {
         let mlp = vb.pp("mlp");
         Ok(Self {
-            layers: [
-                Linear::new(mlp.pp(0), in_dim, d)?,
-                Linear::new(mlp.pp(1), d, d)?,
-            ],
+            layers: [Linear::new(mlp.pp(0), in_dim, d)?, Linear::new(mlp.pp(1), d, d)?],
             norm: Norm::new(vb.pp("norm"), d)?,
         })
     }
@@ -93,14 +87,7 @@ impl ResidualMlp {
 
     fn parameters(&self) -> [&Tensor; 6] {
         let [l1, l2] = &self.layers;
-        [
-            &l1.weight,
-            &l1.bias,
-            &l2.weight,
-            &l2.bias,
-            &self.norm.weight,
-            &self.norm.bias,
-        ]
+        [&l1.weight, &l1.bias, &l2.weight, &l2.bias, &self.norm.weight, &self.norm.bias]
     }
 }
 
@@ -115,12 +102,7 @@ struct Step {
 impl Step {
     /// The aggregated messages plus, with a graph context, `tanh(W·mean(x) + b)` of each node's
     /// graph (stock candle ops: the tensors are `(G, D)`, G a handful of graphs).
-    fn with_context(
-        &self,
-        aggregated: Tensor,
-        x: &Tensor,
-        graph: &GraphInput,
-    ) -> candle_core::Result<Tensor> {
+    fn with_context(&self, aggregated: Tensor, x: &Tensor, graph: &GraphInput) -> candle_core::Result<Tensor> {
         let Some(context) = &self.context else {
             return Ok(aggregated);
         };
@@ -156,10 +138,7 @@ impl Mpn {
                 Ok(Step {
                     edge: ResidualMlp::new(vb.pp("edge"), 3 * d, d)?,
                     node: ResidualMlp::new(vb.pp("node"), 2 * d, d)?,
-                    context: config
-                        .graph_context
-                        .then(|| Linear::new(vb.pp("context"), d, d))
-                        .transpose()?,
+                    context: config.graph_context.then(|| Linear::new(vb.pp("context"), d, d)).transpose()?,
                 })
             })
             .collect::<candle_core::Result<_>>()?;
@@ -169,58 +148,34 @@ impl Mpn {
             node_encoder: Linear::new(vb.pp("node_encoder"), config.node_features, d)?,
             edge_encoder: Linear::new(vb.pp("edge_encoder"), config.edge_features, d)?,
             steps,
-            decoder: [
-                Linear::new(dec.pp(0), d, d)?,
-                Linear::new(dec.pp(1), d, d)?,
-                Linear::new(dec.pp(2), d, 1)?,
-            ],
+            decoder: [Linear::new(dec.pp(0), d, d)?, Linear::new(dec.pp(1), d, d)?, Linear::new(dec.pp(2), d, 1)?],
             config,
         })
     }
 
     /// A freshly initialised trainable network (PyTorch's default initialisation, drawn from a
     /// generator seeded with `seed`) and the `VarMap` holding its variables.
-    pub fn init(
-        config: MpnConfig,
-        seed: u64,
-        dtype: DType,
-        device: &Device,
-    ) -> Result<(Self, VarMap)> {
+    pub fn init(config: MpnConfig, seed: u64, dtype: DType, device: &Device) -> Result<(Self, VarMap)> {
         let varmap = VarMap::new();
-        let vb = VarBuilder::from_backend(
-            Box::new(init::SeededInit::new(varmap.clone(), seed)),
-            dtype,
-            device.clone(),
-        );
+        let vb = VarBuilder::from_backend(Box::new(init::SeededInit::new(varmap.clone(), seed)), dtype, device.clone());
         Ok((Self::new(config, vb)?, varmap))
     }
 
     /// Saves the variables to `path` (safetensors) and the configuration beside it
     /// (`path` with extension `json`).
     pub fn save(&self, varmap: &VarMap, path: &Path) -> Result<()> {
-        let json = serde_json::to_string_pretty(&self.config).map_err(|source| MpnError::Json {
-            path: path.with_extension("json"),
-            source,
-        })?;
-        std::fs::write(path.with_extension("json"), json).map_err(|source| MpnError::Io {
-            path: path.with_extension("json"),
-            source,
-        })?;
-        varmap.save(path).map_err(|e| MpnError::Checkpoint {
-            path: path.into(),
-            message: e.to_string(),
-        })
+        let json = serde_json::to_string_pretty(&self.config)
+            .map_err(|source| MpnError::Json { path: path.with_extension("json"), source })?;
+        std::fs::write(path.with_extension("json"), json)
+            .map_err(|source| MpnError::Io { path: path.with_extension("json"), source })?;
+        varmap.save(path).map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })
     }
 
     /// Loads a checkpoint written by [`Mpn::save`] as plain tensors, for inference.
     pub fn load(path: &Path, dtype: DType, device: &Device) -> Result<Self> {
         let config = read_config(path)?;
-        let checkpoint_err = |e: candle_core::Error| MpnError::Checkpoint {
-            path: path.into(),
-            message: e.to_string(),
-        };
-        let tensors: HashMap<String, Tensor> =
-            candle_core::safetensors::load(path, device).map_err(checkpoint_err)?;
+        let checkpoint_err = |e: candle_core::Error| MpnError::Checkpoint { path: path.into(), message: e.to_string() };
+        let tensors: HashMap<String, Tensor> = candle_core::safetensors::load(path, device).map_err(checkpoint_err)?;
         let stored = tensors.len();
         let model = match Self::new(config, VarBuilder::from_tensors(tensors, dtype, device)) {
             Err(MpnError::Candle(e)) => return Err(checkpoint_err(e)),
@@ -235,15 +190,9 @@ impl Mpn {
         let (model, mut varmap) = Self::init(read_config(path)?, 0, dtype, device)?;
         // `VarMap::load` overwrites the variables the model created (shape-checked); it would
         // load nothing into an empty map.
-        varmap.load(path).map_err(|e| MpnError::Checkpoint {
-            path: path.into(),
-            message: e.to_string(),
-        })?;
+        varmap.load(path).map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })?;
         let stored = candle_core::safetensors::load(path, &Device::Cpu)
-            .map_err(|e| MpnError::Checkpoint {
-                path: path.into(),
-                message: e.to_string(),
-            })?
+            .map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })?
             .len();
         model.check_tensor_count(path, stored)?;
         Ok((model, varmap))
@@ -263,16 +212,10 @@ impl Mpn {
     /// The same network on plain tensors (sharing the variables' storage, so it sees later
     /// optimiser updates): its forward records no autograd graph, for evaluation during training.
     pub fn for_inference(&self) -> Self {
-        let linear = |l: &Linear| Linear {
-            weight: l.weight.detach(),
-            bias: l.bias.detach(),
-        };
+        let linear = |l: &Linear| Linear { weight: l.weight.detach(), bias: l.bias.detach() };
         let mlp = |m: &ResidualMlp| ResidualMlp {
             layers: [linear(&m.layers[0]), linear(&m.layers[1])],
-            norm: Norm {
-                weight: m.norm.weight.detach(),
-                bias: m.norm.bias.detach(),
-            },
+            norm: Norm { weight: m.norm.weight.detach(), bias: m.norm.bias.detach() },
         };
         Self {
             config: self.config.clone(),
@@ -282,17 +225,9 @@ impl Mpn {
             steps: self
                 .steps
                 .iter()
-                .map(|s| Step {
-                    edge: mlp(&s.edge),
-                    node: mlp(&s.node),
-                    context: s.context.as_ref().map(linear),
-                })
+                .map(|s| Step { edge: mlp(&s.edge), node: mlp(&s.node), context: s.context.as_ref().map(linear) })
                 .collect(),
-            decoder: [
-                linear(&self.decoder[0]),
-                linear(&self.decoder[1]),
-                linear(&self.decoder[2]),
-            ],
+            decoder: [linear(&self.decoder[0]), linear(&self.decoder[1]), linear(&self.decoder[2])],
         }
     }
 
@@ -338,11 +273,7 @@ impl Mpn {
 
     /// Training-mode forward: edge dropout with the configured rate, one dropped graph for all
     /// steps, drawn from `rng`.
-    pub fn forward_train<R: Rng + ?Sized>(
-        &self,
-        graph: &GraphInput,
-        rng: &mut R,
-    ) -> Result<Tensor> {
+    pub fn forward_train<R: Rng + ?Sized>(&self, graph: &GraphInput, rng: &mut R) -> Result<Tensor> {
         if self.config.edge_dropout > 0.0 {
             self.forward(&graph.drop_edges(self.config.edge_dropout, rng)?)
         } else {
@@ -360,16 +291,10 @@ impl Mpn {
         let check = |what, t: &Tensor, rows: usize, expected: usize| -> Result<()> {
             let (r, c) = t.dims2()?;
             if c != expected {
-                return Err(MpnError::FeatureDim {
-                    what,
-                    expected,
-                    got: c,
-                });
+                return Err(MpnError::FeatureDim { what, expected, got: c });
             }
             if r != rows {
-                return Err(MpnError::InvalidGraph(format!(
-                    "{r} rows of {what} for {rows} graph items"
-                )));
+                return Err(MpnError::InvalidGraph(format!("{r} rows of {what} for {rows} graph items")));
             }
             if t.dtype() != self.dtype {
                 return Err(MpnError::InvalidGraph(format!(
@@ -380,34 +305,15 @@ impl Mpn {
             }
             Ok(())
         };
-        check(
-            "node features",
-            &g.node_features,
-            g.topology.num_nodes(),
-            self.config.node_features,
-        )?;
-        check(
-            "edge features",
-            &g.edge_features,
-            g.topology.num_edges(),
-            self.config.edge_features,
-        )?;
-        Ok((
-            self.node_encoder.forward(&g.node_features)?,
-            self.edge_encoder.forward(&g.edge_features)?,
-        ))
+        check("node features", &g.node_features, g.topology.num_nodes(), self.config.node_features)?;
+        check("edge features", &g.edge_features, g.topology.num_edges(), self.config.edge_features)?;
+        Ok((self.node_encoder.forward(&g.node_features)?, self.edge_encoder.forward(&g.edge_features)?))
     }
 
     /// The decoder MLP and output transform, with the given `tanh` (fused or candle's).
-    fn decode(
-        &self,
-        x: &Tensor,
-        tanh: impl Fn(&Tensor) -> candle_core::Result<Tensor>,
-    ) -> Result<Tensor> {
+    fn decode(&self, x: &Tensor, tanh: impl Fn(&Tensor) -> candle_core::Result<Tensor>) -> Result<Tensor> {
         let [l1, l2, l3] = &self.decoder;
-        let z = l3
-            .forward(&tanh(&l2.forward(&tanh(&l1.forward(x)?)?)?)?)?
-            .squeeze(1)?;
+        let z = l3.forward(&tanh(&l2.forward(&tanh(&l1.forward(x)?)?)?)?)?.squeeze(1)?;
         Ok(match self.config.output {
             // relu(z) + log(1 + exp(-|z|)): exact and overflow-free for any z.
             OutputTransform::Softplus => (z.relu()? + (z.abs()?.neg()?.exp()? + 1.0)?.log()?)?,
@@ -419,14 +325,9 @@ impl Mpn {
 
 fn read_config(path: &Path) -> Result<MpnConfig> {
     let json_path = path.with_extension("json");
-    let text = std::fs::read_to_string(&json_path).map_err(|source| MpnError::Io {
-        path: json_path.clone(),
-        source,
-    })?;
-    let config: MpnConfig = serde_json::from_str(&text).map_err(|source| MpnError::Json {
-        path: json_path,
-        source,
-    })?;
+    let text =
+        std::fs::read_to_string(&json_path).map_err(|source| MpnError::Io { path: json_path.clone(), source })?;
+    let config: MpnConfig = serde_json::from_str(&text).map_err(|source| MpnError::Json { path: json_path, source })?;
     config.validate()?;
     Ok(config)
 }

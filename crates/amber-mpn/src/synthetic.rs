@@ -32,11 +32,7 @@ pub fn random_graph(
         dst_offsets[v + 1] += dst_offsets[v];
     }
     let num_edges = pairs.len();
-    let mut uniform = |n: usize| {
-        (0..n)
-            .map(|_| rng.random_range(-1.0f32..1.0))
-            .collect::<Vec<_>>()
-    };
+    let mut uniform = |n: usize| (0..n).map(|_| rng.random_range(-1.0f32..1.0)).collect::<Vec<_>>();
     GraphBatch {
         num_nodes,
         node_dim,

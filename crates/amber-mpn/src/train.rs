@@ -18,10 +18,7 @@ pub struct TrainConfig {
 
 impl Default for TrainConfig {
     fn default() -> Self {
-        Self {
-            learning_rate: 3e-4,
-            max_grad_norm: Some(0.5),
-        }
+        Self { learning_rate: 3e-4, max_grad_norm: Some(0.5) }
     }
 }
 
@@ -36,17 +33,9 @@ impl Trainer {
     pub fn new(varmap: &VarMap, config: &TrainConfig) -> Result<Self> {
         let vars = varmap.all_vars();
         // candle's AdamW with zero weight decay is Adam (its default decay is 0.01).
-        let params = ParamsAdamW {
-            lr: config.learning_rate,
-            weight_decay: 0.0,
-            ..Default::default()
-        };
+        let params = ParamsAdamW { lr: config.learning_rate, weight_decay: 0.0, ..Default::default() };
         let optimizer = AdamW::new(vars.clone(), params)?;
-        Ok(Self {
-            vars,
-            optimizer,
-            max_grad_norm: config.max_grad_norm,
-        })
+        Ok(Self { vars, optimizer, max_grad_norm: config.max_grad_norm })
     }
 
     pub fn set_learning_rate(&mut self, lr: f64) {
@@ -71,11 +60,7 @@ pub fn grad_norm(grads: &GradStore, vars: &[Var]) -> Result<f64> {
     let mut sum = 0.0;
     for var in vars {
         if let Some(g) = grads.get(var) {
-            sum += g
-                .to_dtype(DType::F64)?
-                .sqr()?
-                .sum_all()?
-                .to_scalar::<f64>()?;
+            sum += g.to_dtype(DType::F64)?.sqr()?.sum_all()?.to_scalar::<f64>()?;
         }
     }
     Ok(sum.sqrt())

@@ -89,7 +89,12 @@ fn training_lowers_the_loss_and_keeps_the_buffer_invariants() {
     for r in &reports {
         let by_depth: Vec<f64> = r.loss_by_depth.iter().flatten().copied().collect();
         let (lo, hi) = by_depth.iter().fold((f64::INFINITY, 0f64), |(lo, hi), &l| (lo.min(l), hi.max(l)));
-        assert!(lo <= r.loss * (1.0 + 1e-5) && r.loss <= hi * (1.0 + 1e-5), "step {}: {} vs {by_depth:?}", r.step, r.loss);
+        assert!(
+            lo <= r.loss * (1.0 + 1e-5) && r.loss <= hi * (1.0 + 1e-5),
+            "step {}: {} vs {by_depth:?}",
+            r.step,
+            r.loss
+        );
     }
     assert!(reports.iter().any(|r| r.loss_by_depth.iter().flatten().count() > 1), "batches mix depths");
 }
@@ -217,7 +222,9 @@ fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
     // 0.005 everywhere asks for ~70k triangles on the L-shape.
     let fine = vec![0.005; m0.num_elements()];
     let outcome = amber_train::generation_step(&problem, &m0, fine.clone(), &limits);
-    assert!(matches!(outcome, amber_train::StepOutcome::OverBudget { estimated_elements } if estimated_elements > 50_000.0));
+    assert!(
+        matches!(outcome, amber_train::StepOutcome::OverBudget { estimated_elements } if estimated_elements > 50_000.0)
+    );
     limits.scale_to_budget = true;
     let amber_train::StepOutcome::Meshed(mesh) = amber_train::generation_step(&problem, &m0, fine, &limits) else {
         panic!("a field scaled to the budget is meshed")
@@ -244,8 +251,7 @@ fn the_optional_features_reach_a_saved_model_that_predicts_on_new_meshes() {
     assert_eq!(model.network.config().node_features, 7, "the paper's 4 node features + 3");
 
     let problem = &problems[0];
-    let state =
-        amber_train::MeshState::new(problem, &model.predictor.features, problem.expert_mesh.clone()).unwrap();
+    let state = amber_train::MeshState::new(problem, &model.predictor.features, problem.expert_mesh.clone()).unwrap();
     let sizes = model.predict(&[&state]).unwrap();
     assert_eq!(sizes[0].len(), problem.expert_mesh.num_elements());
     assert!(sizes[0].iter().all(|h| h.is_finite() && *h > 0.0));

@@ -336,10 +336,10 @@ fn norm(a: [f64; 3]) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::unit_cube_triangles as cube_triangles;
     use super::*;
     use crate::mesh3d::console_reference_surfaces;
     use crate::mesh3d::surface::StlFaceIds;
-    use super::super::unit_cube_triangles as cube_triangles;
     use crate::{ConstantSize, FnSize, MeshSizing};
     use proptest::prelude::*;
     use proptest::test_runner::RngSeed;

@@ -17,40 +17,25 @@ pub(super) struct SeededInit {
 
 impl SeededInit {
     pub fn new(varmap: VarMap, seed: u64) -> Self {
-        Self {
-            varmap,
-            rng: Mutex::new(StdRng::seed_from_u64(seed)),
-        }
+        Self { varmap, rng: Mutex::new(StdRng::seed_from_u64(seed)) }
     }
 }
 
 impl SimpleBackend for SeededInit {
-    fn get(
-        &self,
-        s: Shape,
-        name: &str,
-        h: Init,
-        dtype: DType,
-        dev: &Device,
-    ) -> candle_core::Result<Tensor> {
+    fn get(&self, s: Shape, name: &str, h: Init, dtype: DType, dev: &Device) -> candle_core::Result<Tensor> {
         let (Ok(mut vars), Ok(mut rng)) = (self.varmap.data().lock(), self.rng.lock()) else {
             bail!("poisoned variable map");
         };
         if let Some(var) = vars.get(name) {
             if var.shape() != &s {
-                bail!(
-                    "variable {name} has shape {:?}, expected {s:?}",
-                    var.shape()
-                );
+                bail!("variable {name} has shape {:?}, expected {s:?}", var.shape());
             }
             return Ok(var.as_tensor().clone());
         }
         let n = s.elem_count();
         let values: Vec<f64> = match h {
             Init::Const(c) => vec![c; n],
-            Init::Uniform { lo, up } => (0..n)
-                .map(|_| lo + (up - lo) * rng.random::<f64>())
-                .collect(),
+            Init::Uniform { lo, up } => (0..n).map(|_| lo + (up - lo) * rng.random::<f64>()).collect(),
             other => bail!("unsupported initialisation {other:?} for {name}"),
         };
         let var = Var::from_tensor(&Tensor::from_vec(values, s, dev)?.to_dtype(dtype)?)?;
@@ -58,20 +43,11 @@ impl SimpleBackend for SeededInit {
         Ok(var.as_tensor().clone())
     }
 
-    fn get_unchecked(
-        &self,
-        name: &str,
-        _dtype: DType,
-        _dev: &Device,
-    ) -> candle_core::Result<Tensor> {
+    fn get_unchecked(&self, name: &str, _dtype: DType, _dev: &Device) -> candle_core::Result<Tensor> {
         bail!("{name}: the seeded initialiser needs a shape")
     }
 
     fn contains_tensor(&self, name: &str) -> bool {
-        self.varmap
-            .data()
-            .lock()
-            .map(|v| v.contains_key(name))
-            .unwrap_or(false)
+        self.varmap.data().lock().map(|v| v.contains_key(name)).unwrap_or(false)
     }
 }

@@ -13,18 +13,13 @@ use rayon::prelude::*;
 use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch};
 use crate::graph::Topology;
 use crate::kernels::{
-    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, add_assign, add_gathered, matmul,
-    packed_len, segment_sum, tail_backward, tail_forward,
+    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, add_assign, add_gathered, matmul, packed_len, segment_sum,
+    tail_backward, tail_forward,
 };
 
 /// New edge states (E×D) from node states `x` (N×D), edge states `e` (E×D) and the packed edge
 /// MLP + LayerNorm parameters `theta` (see [`crate::kernels::packed_len`] with input 3D).
-pub(crate) fn edge_update(
-    x: &Tensor,
-    e: &Tensor,
-    theta: &Tensor,
-    topology: &Arc<Topology>,
-) -> Result<Tensor> {
+pub(crate) fn edge_update(x: &Tensor, e: &Tensor, theta: &Tensor, topology: &Arc<Topology>) -> Result<Tensor> {
     let (x, e, theta) = (x.contiguous()?, e.contiguous()?, theta.contiguous()?);
     let op = EdgeUpdate {
         topology: topology.clone(),
@@ -46,13 +41,10 @@ impl EdgeUpdate {
     fn check(&self, x: usize, e: usize, theta: usize) -> Result<()> {
         let (n, m, d) = (self.topology.num_nodes(), self.topology.num_edges(), self.d);
         if x != n * d || e != m * d || theta != packed_len(3 * d, d) {
-            bail!(
-                "edge_update: got {x} node, {e} edge and {theta} parameter values for N={n}, E={m}, D={d}"
-            );
+            bail!("edge_update: got {x} node, {e} edge and {theta} parameter values for N={n}, E={m}, D={d}");
         }
         Ok(())
     }
-
 }
 
 impl FusedMlpOp for EdgeUpdate {
@@ -69,11 +61,7 @@ impl FusedMlpOp for EdgeUpdate {
         let w = MlpWeights::unpack(theta, 3 * d, d);
         let zero = T::from_f64(0.0);
         let (mut p, mut q) = (vec![zero; n * d], vec![zero; n * d]);
-        (
-            p.par_chunks_mut(BLOCK_ROWS * d),
-            q.par_chunks_mut(BLOCK_ROWS * d),
-            x.par_chunks(BLOCK_ROWS * d),
-        )
+        (p.par_chunks_mut(BLOCK_ROWS * d), q.par_chunks_mut(BLOCK_ROWS * d), x.par_chunks(BLOCK_ROWS * d))
             .into_par_iter()
             .for_each(|(p, q, x)| {
                 let rows = x.len() / d;
@@ -82,37 +70,16 @@ impl FusedMlpOp for EdgeUpdate {
             });
         let block = |b: usize, e: &[T], st: TailState<'_, T>, out: &mut [T]| {
             let rows = e.len() / d;
-            matmul(
-                rows,
-                d,
-                d,
-                e,
-                false,
-                w.w1_rows(2 * d..3 * d),
-                false,
-                st.h1,
-                false,
-            );
+            matmul(rows, d, d, e, false, w.w1_rows(2 * d..3 * d), false, st.h1, false);
             let edges = b * BLOCK_ROWS..b * BLOCK_ROWS + rows;
-            add_gathered(
-                st.h1,
-                &p,
-                &q,
-                &self.topology.src()[edges.clone()],
-                &self.topology.dst()[edges],
-                d,
-            );
+            add_gathered(st.h1, &p, &q, &self.topology.src()[edges.clone()], &self.topology.dst()[edges], d);
             tail_forward(&w, e, st, out);
         };
         let mut out = vec![zero; m * d];
         let chunk = BLOCK_ROWS * d;
         if self.save {
-            let (mut h1, mut h2, mut mean, mut rstd) = (
-                vec![zero; m * d],
-                vec![zero; m * d],
-                vec![zero; m],
-                vec![zero; m],
-            );
+            let (mut h1, mut h2, mut mean, mut rstd) =
+                (vec![zero; m * d], vec![zero; m * d], vec![zero; m], vec![zero; m]);
             (
                 out.par_chunks_mut(chunk),
                 e.par_chunks(chunk),
@@ -123,9 +90,7 @@ impl FusedMlpOp for EdgeUpdate {
             )
                 .into_par_iter()
                 .enumerate()
-                .for_each(|(b, (out, e, h1, h2, mean, rstd))| {
-                    block(b, e, TailState { h1, h2, mean, rstd }, out)
-                });
+                .for_each(|(b, (out, e, h1, h2, mean, rstd))| block(b, e, TailState { h1, h2, mean, rstd }, out));
             self.saved.put(Saved {
                 h1: T::to_cpu_storage_owned(h1),
                 h2: T::to_cpu_storage_owned(h2),
@@ -133,13 +98,10 @@ impl FusedMlpOp for EdgeUpdate {
                 rstd: T::to_cpu_storage_owned(rstd),
             })?;
         } else {
-            (out.par_chunks_mut(chunk), e.par_chunks(chunk))
-                .into_par_iter()
-                .enumerate()
-                .for_each_init(
-                    || Scratch::new(BLOCK_ROWS, d),
-                    |scratch, (b, (out, e))| block(b, e, scratch.state(e.len() / d, d), out),
-                );
+            (out.par_chunks_mut(chunk), e.par_chunks(chunk)).into_par_iter().enumerate().for_each_init(
+                || Scratch::new(BLOCK_ROWS, d),
+                |scratch, (b, (out, e))| block(b, e, scratch.state(e.len() / d, d), out),
+            );
         }
         Ok(out)
     }
@@ -149,10 +111,7 @@ impl FusedMlpOp for EdgeUpdate {
         let saved = self.saved.take(Self::NAME)?;
         // The backward overwrites the saved activations with gradients: h1 becomes d(first-layer
         // pre-activation), h2 becomes d(e), saving two edge-sized allocations.
-        let (mut dpre1, mut de) = (
-            T::cpu_storage_data(saved.h1)?,
-            T::cpu_storage_data(saved.h2)?,
-        );
+        let (mut dpre1, mut de) = (T::cpu_storage_data(saved.h1)?, T::cpu_storage_data(saved.h2)?);
         let (mean, rstd) = (saved.mean.as_slice::<T>()?, saved.rstd.as_slice::<T>()?);
         let d = self.d;
         let (n, m) = (self.topology.num_nodes(), self.topology.num_edges());
@@ -176,39 +135,9 @@ impl FusedMlpOp for EdgeUpdate {
                 || (MlpGrads::zeros(3 * d, d), vec![zero; 2 * chunk]),
                 |(mut g, mut scratch), (de, dpre1, gr, e, mean, rstd)| {
                     let rows = e.len() / d;
-                    tail_backward(
-                        &w,
-                        gr,
-                        e,
-                        dpre1,
-                        de,
-                        mean,
-                        rstd,
-                        &mut scratch[..2 * rows * d],
-                        &mut g,
-                    );
-                    matmul(
-                        rows,
-                        d,
-                        d,
-                        dpre1,
-                        false,
-                        w.w1_rows(2 * d..3 * d),
-                        true,
-                        de,
-                        true,
-                    );
-                    matmul(
-                        d,
-                        rows,
-                        d,
-                        e,
-                        true,
-                        dpre1,
-                        false,
-                        &mut g.w1[2 * d * d..],
-                        true,
-                    );
+                    tail_backward(&w, gr, e, dpre1, de, mean, rstd, &mut scratch[..2 * rows * d], &mut g);
+                    matmul(rows, d, d, dpre1, false, w.w1_rows(2 * d..3 * d), true, de, true);
+                    matmul(d, rows, d, e, true, dpre1, false, &mut g.w1[2 * d * d..], true);
                     (g, scratch)
                 },
             )
@@ -218,27 +147,12 @@ impl FusedMlpOp for EdgeUpdate {
         // Gradients of the gathered node products: segment sums by source and by destination.
         let (mut dp, mut dq) = (vec![zero; n * d], vec![zero; n * d]);
         let topo = &self.topology;
-        (dp.par_chunks_mut(chunk), dq.par_chunks_mut(chunk))
-            .into_par_iter()
-            .enumerate()
-            .for_each(|(b, (dp, dq))| {
-                segment_sum(
-                    dp,
-                    &dpre1,
-                    topo.src_offsets(),
-                    Some(topo.by_src()),
-                    b * BLOCK_ROWS,
-                    d,
-                );
-                segment_sum(dq, &dpre1, topo.dst_offsets(), None, b * BLOCK_ROWS, d);
-            });
+        (dp.par_chunks_mut(chunk), dq.par_chunks_mut(chunk)).into_par_iter().enumerate().for_each(|(b, (dp, dq))| {
+            segment_sum(dp, &dpre1, topo.src_offsets(), Some(topo.by_src()), b * BLOCK_ROWS, d);
+            segment_sum(dq, &dpre1, topo.dst_offsets(), None, b * BLOCK_ROWS, d);
+        });
         let mut dx = vec![zero; n * d];
-        let dw_nodes = (
-            dx.par_chunks_mut(chunk),
-            dp.par_chunks(chunk),
-            dq.par_chunks(chunk),
-            xv.par_chunks(chunk),
-        )
+        let dw_nodes = (dx.par_chunks_mut(chunk), dp.par_chunks(chunk), dq.par_chunks(chunk), xv.par_chunks(chunk))
             .into_par_iter()
             .fold(
                 || vec![zero; 2 * d * d],
@@ -278,24 +192,13 @@ mod tests {
             let dev = t[0].device();
             let src = Tensor::from_slice(topo.src(), topo.num_edges(), dev)?;
             let dst = Tensor::from_slice(topo.dst(), topo.num_edges(), dev)?;
-            let message = Tensor::cat(
-                &[
-                    &t[0].index_select(&src, 0)?,
-                    &t[0].index_select(&dst, 0)?,
-                    &t[1],
-                ],
-                1,
-            )?;
+            let message = Tensor::cat(&[&t[0].index_select(&src, 0)?, &t[0].index_select(&dst, 0)?, &t[1]], 1)?;
             probe_loss(&composed_residual_mlp(&message, &t[1], &t[2])?, 7)
         }
     }
 
     fn inputs(topo: &Topology, d: usize) -> Vec<Tensor> {
-        vec![
-            random((topo.num_nodes(), d), 1),
-            random((topo.num_edges(), d), 2),
-            random_theta(3 * d, d, 3),
-        ]
+        vec![random((topo.num_nodes(), d), 1), random((topo.num_edges(), d), 2), random_theta(3 * d, d, 3)]
     }
 
     #[test]
@@ -309,10 +212,7 @@ mod tests {
         for topo in [corner_case_graph(), multi_block_graph()] {
             let t = inputs(&topo, 4);
             let (f, c) = (fused(&topo), composed(&topo));
-            let (lf, lc) = (
-                f(&t).unwrap().to_scalar::<f64>().unwrap(),
-                c(&t).unwrap().to_scalar::<f64>().unwrap(),
-            );
+            let (lf, lc) = (f(&t).unwrap().to_scalar::<f64>().unwrap(), c(&t).unwrap().to_scalar::<f64>().unwrap());
             assert!((lf - lc).abs() < 1e-9 * lc.abs().max(1.0), "{lf} vs {lc}");
             assert_close(&autograd(&t, &f), &autograd(&t, &c), 1e-10);
         }
@@ -321,10 +221,7 @@ mod tests {
     #[test]
     fn inference_path_equals_training_path() {
         let topo = multi_block_graph();
-        let t: Vec<Tensor> = inputs(&topo, 4)
-            .iter()
-            .map(|t| t.to_dtype(candle_core::DType::F32).unwrap())
-            .collect();
+        let t: Vec<Tensor> = inputs(&topo, 4).iter().map(|t| t.to_dtype(candle_core::DType::F32).unwrap()).collect();
         let plain = edge_update(&t[0], &t[1], &t[2], &topo).unwrap();
         let var = candle_core::Var::from_tensor(&t[1]).unwrap();
         let tracked = edge_update(&t[0], var.as_tensor(), &t[2], &topo).unwrap();

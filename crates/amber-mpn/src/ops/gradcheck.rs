@@ -25,19 +25,12 @@ pub fn multi_block_graph() -> Arc<Topology> {
 
 pub fn random(shape: (usize, usize), seed: u64) -> Tensor {
     let mut rng = StdRng::seed_from_u64(seed);
-    let v: Vec<f64> = (0..shape.0 * shape.1)
-        .map(|_| rng.random_range(-1.0..1.0))
-        .collect();
+    let v: Vec<f64> = (0..shape.0 * shape.1).map(|_| rng.random_range(-1.0..1.0)).collect();
     Tensor::from_vec(v, shape, &Device::Cpu).unwrap()
 }
 
 pub fn values(t: &Tensor) -> Vec<f64> {
-    t.to_dtype(DType::F64)
-        .unwrap()
-        .flatten_all()
-        .unwrap()
-        .to_vec1()
-        .unwrap()
+    t.to_dtype(DType::F64).unwrap().flatten_all().unwrap().to_vec1().unwrap()
 }
 
 /// Weighted sum of the output, so that every output entry gets a distinct gradient.
@@ -47,26 +40,15 @@ pub fn probe_loss(out: &Tensor, seed: u64) -> candle_core::Result<Tensor> {
 }
 
 /// Gradients of `loss(inputs)` with respect to every input, via autograd.
-pub fn autograd(
-    inputs: &[Tensor],
-    loss: &dyn Fn(&[Tensor]) -> candle_core::Result<Tensor>,
-) -> Vec<Vec<f64>> {
-    let vars: Vec<Var> = inputs
-        .iter()
-        .map(|t| Var::from_tensor(t).unwrap())
-        .collect();
+pub fn autograd(inputs: &[Tensor], loss: &dyn Fn(&[Tensor]) -> candle_core::Result<Tensor>) -> Vec<Vec<f64>> {
+    let vars: Vec<Var> = inputs.iter().map(|t| Var::from_tensor(t).unwrap()).collect();
     let tensors: Vec<Tensor> = vars.iter().map(|v| v.as_tensor().clone()).collect();
     let grads = loss(&tensors).unwrap().backward().unwrap();
-    vars.iter()
-        .map(|v| values(grads.get(v).expect("every input gets a gradient")))
-        .collect()
+    vars.iter().map(|v| values(grads.get(v).expect("every input gets a gradient"))).collect()
 }
 
 /// Compares autograd with central differences (step 1e-6) on up to 40 entries per input.
-pub fn check_finite_differences(
-    inputs: &[Tensor],
-    loss: &dyn Fn(&[Tensor]) -> candle_core::Result<Tensor>,
-) {
+pub fn check_finite_differences(inputs: &[Tensor], loss: &dyn Fn(&[Tensor]) -> candle_core::Result<Tensor>) {
     let analytic = autograd(inputs, loss);
     let eval = |i: usize, idx: usize, delta: f64| {
         let mut v = values(&inputs[i]);
@@ -81,11 +63,7 @@ pub fn check_finite_differences(
         for idx in (0..grad.len()).step_by(step) {
             let fd = (eval(i, idx, eps) - eval(i, idx, -eps)) / (2.0 * eps);
             let err = (fd - grad[idx]).abs() / fd.abs().max(grad[idx].abs()).max(1.0);
-            assert!(
-                err < 1e-6,
-                "input {i} entry {idx}: finite difference {fd}, autograd {}",
-                grad[idx]
-            );
+            assert!(err < 1e-6, "input {i} entry {idx}: finite difference {fd}, autograd {}", grad[idx]);
         }
     }
 }
@@ -95,21 +73,14 @@ pub fn assert_close(a: &[Vec<f64>], b: &[Vec<f64>], tol: f64) {
     for (i, (ga, gb)) in a.iter().zip(b).enumerate() {
         let scale = ga.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         for (j, (x, y)) in ga.iter().zip(gb).enumerate() {
-            assert!(
-                (x - y).abs() <= tol * scale,
-                "input {i} entry {j}: {x} vs {y}"
-            );
+            assert!((x - y).abs() <= tol * scale, "input {i} entry {j}: {x} vs {y}");
         }
     }
 }
 
 /// `LayerNorm(residual + MLP(input))` from stock candle ops, with the parameters unpacked from
 /// the flat vector the fused ops take.
-pub fn composed_residual_mlp(
-    input: &Tensor,
-    residual: &Tensor,
-    theta: &Tensor,
-) -> candle_core::Result<Tensor> {
+pub fn composed_residual_mlp(input: &Tensor, residual: &Tensor, theta: &Tensor) -> candle_core::Result<Tensor> {
     use candle_nn::ops::{layer_norm_slow, leaky_relu};
     let (in_dim, d) = (input.dim(1)?, residual.dim(1)?);
     let mut offset = 0;
@@ -128,7 +99,5 @@ pub fn composed_residual_mlp(
 }
 
 pub fn random_theta(in_dim: usize, d: usize, seed: u64) -> Tensor {
-    random((1, crate::kernels::packed_len(in_dim, d)), seed)
-        .flatten_all()
-        .unwrap()
+    random((1, crate::kernels::packed_len(in_dim, d)), seed).flatten_all().unwrap()
 }

@@ -41,11 +41,7 @@ fn tensor_slice<'a, T: Real>(storage: &'a Storage, l: &Layout) -> Result<&'a [T]
 
 fn float_dtype(op: &str, dtypes: &[DType]) -> Result<DType> {
     match dtypes {
-        [first, rest @ ..]
-            if matches!(first, DType::F32 | DType::F64) && rest.iter().all(|d| d == first) =>
-        {
-            Ok(*first)
-        }
+        [first, rest @ ..] if matches!(first, DType::F32 | DType::F64) && rest.iter().all(|d| d == first) => Ok(*first),
         _ => bail!("{op}: inputs must be all f32 or all f64, got {dtypes:?}"),
     }
 }
@@ -168,12 +164,7 @@ struct Scratch<T> {
 impl<T: Real> Scratch<T> {
     fn new(rows: usize, d: usize) -> Self {
         let z = |n| vec![T::from_f64(0.0); n];
-        Self {
-            h1: z(rows * d),
-            h2: z(rows * d),
-            mean: z(rows),
-            rstd: z(rows),
-        }
+        Self { h1: z(rows * d), h2: z(rows * d), mean: z(rows), rstd: z(rows) }
     }
 
     fn state(&mut self, rows: usize, d: usize) -> crate::kernels::TailState<'_, T> {

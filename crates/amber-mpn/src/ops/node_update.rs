@@ -6,8 +6,7 @@ use rayon::prelude::*;
 
 use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch};
 use crate::kernels::{
-    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, matmul, packed_len, tail_backward,
-    tail_forward,
+    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, matmul, packed_len, tail_backward, tail_forward,
 };
 
 /// New node states (N×D) from node states `x` and aggregated messages `a` (both N×D) and the
@@ -34,13 +33,10 @@ impl NodeUpdate {
     fn check(&self, x: usize, a: usize, theta: usize) -> Result<()> {
         let (n, d) = (self.rows, self.d);
         if x != n * d || a != n * d || theta != packed_len(2 * d, d) {
-            bail!(
-                "node_update: got {x} node, {a} aggregate and {theta} parameter values for N={n}, D={d}"
-            );
+            bail!("node_update: got {x} node, {a} aggregate and {theta} parameter values for N={n}, D={d}");
         }
         Ok(())
     }
-
 }
 
 impl FusedMlpOp for NodeUpdate {
@@ -57,29 +53,15 @@ impl FusedMlpOp for NodeUpdate {
         let block = |x: &[T], a: &[T], st: TailState<'_, T>, out: &mut [T]| {
             let rows = x.len() / d;
             matmul(rows, d, d, x, false, w.w1_rows(0..d), false, st.h1, false);
-            matmul(
-                rows,
-                d,
-                d,
-                a,
-                false,
-                w.w1_rows(d..2 * d),
-                false,
-                st.h1,
-                true,
-            );
+            matmul(rows, d, d, a, false, w.w1_rows(d..2 * d), false, st.h1, true);
             tail_forward(&w, x, st, out);
         };
         let zero = T::from_f64(0.0);
         let chunk = BLOCK_ROWS * d;
         let mut out = vec![zero; n * d];
         if self.save {
-            let (mut h1, mut h2, mut mean, mut rstd) = (
-                vec![zero; n * d],
-                vec![zero; n * d],
-                vec![zero; n],
-                vec![zero; n],
-            );
+            let (mut h1, mut h2, mut mean, mut rstd) =
+                (vec![zero; n * d], vec![zero; n * d], vec![zero; n], vec![zero; n]);
             (
                 out.par_chunks_mut(chunk),
                 x.par_chunks(chunk),
@@ -90,9 +72,7 @@ impl FusedMlpOp for NodeUpdate {
                 rstd.par_chunks_mut(BLOCK_ROWS),
             )
                 .into_par_iter()
-                .for_each(|(out, x, a, h1, h2, mean, rstd)| {
-                    block(x, a, TailState { h1, h2, mean, rstd }, out)
-                });
+                .for_each(|(out, x, a, h1, h2, mean, rstd)| block(x, a, TailState { h1, h2, mean, rstd }, out));
             self.saved.put(Saved {
                 h1: T::to_cpu_storage_owned(h1),
                 h2: T::to_cpu_storage_owned(h2),
@@ -100,16 +80,10 @@ impl FusedMlpOp for NodeUpdate {
                 rstd: T::to_cpu_storage_owned(rstd),
             })?;
         } else {
-            (
-                out.par_chunks_mut(chunk),
-                x.par_chunks(chunk),
-                a.par_chunks(chunk),
-            )
-                .into_par_iter()
-                .for_each_init(
-                    || Scratch::new(BLOCK_ROWS, d),
-                    |scratch, (out, x, a)| block(x, a, scratch.state(x.len() / d, d), out),
-                );
+            (out.par_chunks_mut(chunk), x.par_chunks(chunk), a.par_chunks(chunk)).into_par_iter().for_each_init(
+                || Scratch::new(BLOCK_ROWS, d),
+                |scratch, (out, x, a)| block(x, a, scratch.state(x.len() / d, d), out),
+            );
         }
         Ok(out)
     }
@@ -119,10 +93,7 @@ impl FusedMlpOp for NodeUpdate {
         let saved = self.saved.take(Self::NAME)?;
         // As in the edge update, the saved activations are overwritten with gradients: h2 becomes
         // d(x), h1 the first-layer pre-activation gradient.
-        let (mut h1, mut dx) = (
-            T::cpu_storage_data(saved.h1)?,
-            T::cpu_storage_data(saved.h2)?,
-        );
+        let (mut h1, mut dx) = (T::cpu_storage_data(saved.h1)?, T::cpu_storage_data(saved.h2)?);
         let (mean, rstd) = (saved.mean.as_slice::<T>()?, saved.rstd.as_slice::<T>()?);
         let (n, d) = (self.rows, self.d);
         if h1.len() != n * d || dx.len() != n * d {
@@ -147,29 +118,9 @@ impl FusedMlpOp for NodeUpdate {
                 || (MlpGrads::zeros(2 * d, d), vec![zero; 2 * chunk]),
                 |(mut g, mut scratch), (dx, da, dpre1, gr, x, a, mean, rstd)| {
                     let rows = x.len() / d;
-                    tail_backward(
-                        &w,
-                        gr,
-                        x,
-                        dpre1,
-                        dx,
-                        mean,
-                        rstd,
-                        &mut scratch[..2 * rows * d],
-                        &mut g,
-                    );
+                    tail_backward(&w, gr, x, dpre1, dx, mean, rstd, &mut scratch[..2 * rows * d], &mut g);
                     matmul(rows, d, d, dpre1, false, w.w1_rows(0..d), true, dx, true);
-                    matmul(
-                        rows,
-                        d,
-                        d,
-                        dpre1,
-                        false,
-                        w.w1_rows(d..2 * d),
-                        true,
-                        da,
-                        false,
-                    );
+                    matmul(rows, d, d, dpre1, false, w.w1_rows(d..2 * d), true, da, false);
                     let (w1x, w1a) = g.w1.split_at_mut(d * d);
                     matmul(d, rows, d, x, true, dpre1, false, w1x, true);
                     matmul(d, rows, d, a, true, dpre1, false, w1a, true);
@@ -192,10 +143,7 @@ mod tests {
     }
 
     fn composed(t: &[Tensor]) -> Result<Tensor> {
-        probe_loss(
-            &composed_residual_mlp(&Tensor::cat(&[&t[0], &t[1]], 1)?, &t[0], &t[2])?,
-            7,
-        )
+        probe_loss(&composed_residual_mlp(&Tensor::cat(&[&t[0], &t[1]], 1)?, &t[0], &t[2])?, 7)
     }
 
     #[test]
@@ -209,9 +157,8 @@ mod tests {
         for n in [5, 600] {
             let t = [random((n, 4), 1), random((n, 4), 2), random_theta(8, 4, 3)];
             assert!(
-                (fused(&t).unwrap().to_scalar::<f64>().unwrap()
-                    - composed(&t).unwrap().to_scalar::<f64>().unwrap())
-                .abs()
+                (fused(&t).unwrap().to_scalar::<f64>().unwrap() - composed(&t).unwrap().to_scalar::<f64>().unwrap())
+                    .abs()
                     < 1e-9
             );
             assert_close(&autograd(&t, &fused), &autograd(&t, &composed), 1e-10);

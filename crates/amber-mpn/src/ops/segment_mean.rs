@@ -15,10 +15,7 @@ use crate::kernels::{BLOCK_ROWS, Real, segment_sum};
 pub(crate) fn segment_mean(e: &Tensor, topology: &Arc<Topology>) -> Result<Tensor> {
     let e = e.contiguous()?;
     let d = e.dim(1)?;
-    e.apply_op1(SegmentMean {
-        topology: topology.clone(),
-        d,
-    })
+    e.apply_op1(SegmentMean { topology: topology.clone(), d })
 }
 
 struct SegmentMean {
@@ -31,26 +28,20 @@ impl SegmentMean {
     fn inv_count<T: Real>(&self, v: usize) -> (usize, usize, T) {
         let offsets = self.topology.dst_offsets();
         let (lo, hi) = (offsets[v] as usize, offsets[v + 1] as usize);
-        let inv = if hi > lo {
-            T::from_f64(1.0 / (hi - lo) as f64)
-        } else {
-            T::from_f64(0.0)
-        };
+        let inv = if hi > lo { T::from_f64(1.0 / (hi - lo) as f64) } else { T::from_f64(0.0) };
         (lo, hi, inv)
     }
 
     fn forward<T: Real>(&self, e: &[T]) -> Vec<T> {
         let d = self.d;
         let mut out = vec![T::from_f64(0.0); self.topology.num_nodes() * d];
-        out.par_chunks_mut(BLOCK_ROWS * d)
-            .enumerate()
-            .for_each(|(b, out)| {
-                segment_sum(out, e, self.topology.dst_offsets(), None, b * BLOCK_ROWS, d);
-                for (i, o) in out.chunks_exact_mut(d).enumerate() {
-                    let (.., inv) = self.inv_count::<T>(b * BLOCK_ROWS + i);
-                    o.iter_mut().for_each(|v| *v *= inv);
-                }
-            });
+        out.par_chunks_mut(BLOCK_ROWS * d).enumerate().for_each(|(b, out)| {
+            segment_sum(out, e, self.topology.dst_offsets(), None, b * BLOCK_ROWS, d);
+            for (i, o) in out.chunks_exact_mut(d).enumerate() {
+                let (.., inv) = self.inv_count::<T>(b * BLOCK_ROWS + i);
+                o.iter_mut().for_each(|v| *v *= inv);
+            }
+        });
         out
     }
 
@@ -94,10 +85,7 @@ impl CustomOp1 for SegmentMean {
     fn cpu_fwd(&self, s: &CpuStorage, l: &Layout) -> Result<(CpuStorage, Shape)> {
         let (m, d) = (self.topology.num_edges(), self.d);
         if l.shape().elem_count() != m * d {
-            bail!(
-                "segment_mean: {} values for E={m}, D={d}",
-                l.shape().elem_count()
-            );
+            bail!("segment_mean: {} values for E={m}, D={d}", l.shape().elem_count());
         }
         let storage = match float_dtype(self.name(), &[s.dtype()])? {
             candle_core::DType::F32 => CpuStorage::F32(self.forward::<f32>(cpu_slice(s, l)?)),
@@ -111,9 +99,7 @@ impl CustomOp1 for SegmentMean {
         let (gs, gl) = grad.storage_and_layout();
         let shape = (self.topology.num_edges(), self.d);
         let de = match float_dtype(self.name(), &[grad.dtype()])? {
-            candle_core::DType::F32 => {
-                tensor_of(self.backward::<f32>(tensor_slice(&gs, gl)?), shape, e)?
-            }
+            candle_core::DType::F32 => tensor_of(self.backward::<f32>(tensor_slice(&gs, gl)?), shape, e)?,
             _ => tensor_of(self.backward::<f64>(tensor_slice(&gs, gl)?), shape, e)?,
         };
         Ok(Some(de))
@@ -136,21 +122,11 @@ mod tests {
             let inv: Vec<f64> = topo
                 .dst_offsets()
                 .windows(2)
-                .map(|w| {
-                    if w[1] > w[0] {
-                        1.0 / (w[1] - w[0]) as f64
-                    } else {
-                        0.0
-                    }
-                })
+                .map(|w| if w[1] > w[0] { 1.0 / (w[1] - w[0]) as f64 } else { 0.0 })
                 .collect();
             let inv = Tensor::from_vec(inv, (topo.num_nodes(), 1), t[0].device())?;
-            let sum = Tensor::zeros(
-                (topo.num_nodes(), t[0].dim(1)?),
-                t[0].dtype(),
-                t[0].device(),
-            )?
-            .index_add(&dst, &t[0], 0)?;
+            let sum = Tensor::zeros((topo.num_nodes(), t[0].dim(1)?), t[0].dtype(), t[0].device())?
+                .index_add(&dst, &t[0], 0)?;
             probe_loss(&sum.broadcast_mul(&inv)?, 7)
         }
     }
@@ -160,11 +136,7 @@ mod tests {
         for topo in [corner_case_graph(), multi_block_graph()] {
             let t = [random((topo.num_edges(), 3), 1)];
             check_finite_differences(&t, &fused(&topo));
-            assert_close(
-                &autograd(&t, &fused(&topo)),
-                &autograd(&t, &composed(&topo)),
-                1e-12,
-            );
+            assert_close(&autograd(&t, &fused(&topo)), &autograd(&t, &composed(&topo)), 1e-12);
         }
     }
 

@@ -28,13 +28,11 @@ impl Tanh {
     fn backward<T: Real>(y: &[T], grad: &[T]) -> Vec<T> {
         let one = T::from_f64(1.0);
         let mut out = grad.to_vec();
-        out.par_chunks_mut(CHUNK)
-            .zip(y.par_chunks(CHUNK))
-            .for_each(|(g, y)| {
-                for (g, &y) in g.iter_mut().zip(y) {
-                    *g *= one - y * y;
-                }
-            });
+        out.par_chunks_mut(CHUNK).zip(y.par_chunks(CHUNK)).for_each(|(g, y)| {
+            for (g, &y) in g.iter_mut().zip(y) {
+                *g *= one - y * y;
+            }
+        });
         out
     }
 }
@@ -79,17 +77,11 @@ mod tests {
 
     #[test]
     fn f32_is_accurate() {
-        let x: Vec<f32> = (-40_000..=40_000)
-            .map(|i| i as f32 * 2.5e-4)
-            .chain([-1e30, -88.0, 88.0, 1e30])
-            .collect();
+        let x: Vec<f32> = (-40_000..=40_000).map(|i| i as f32 * 2.5e-4).chain([-1e30, -88.0, 88.0, 1e30]).collect();
         let y = Tanh::forward(&x);
         for (&x, &y) in x.iter().zip(&y) {
             let exact = (x as f64).tanh();
-            assert!(
-                (y as f64 - exact).abs() < 5e-7,
-                "tanh({x}) = {y}, exact {exact}"
-            );
+            assert!((y as f64 - exact).abs() < 5e-7, "tanh({x}) = {y}, exact {exact}");
         }
     }
 
@@ -98,10 +90,6 @@ mod tests {
         let t = [random((7, 5), 1).affine(3.0, 0.0).unwrap()];
         check_finite_differences(&t, &|t: &[Tensor]| probe_loss(&tanh(&t[0])?, 2));
         let candle = |t: &[Tensor]| probe_loss(&t[0].tanh()?, 2);
-        assert_close(
-            &autograd(&t, &|t: &[Tensor]| probe_loss(&tanh(&t[0])?, 2)),
-            &autograd(&t, &candle),
-            1e-12,
-        );
+        assert_close(&autograd(&t, &|t: &[Tensor]| probe_loss(&tanh(&t[0])?, 2)), &autograd(&t, &candle), 1e-12);
     }
 }
