@@ -1,6 +1,7 @@
-//! Repository hygiene, enforced by plain `cargo test`: every Rust file starts with a `//!`
-//! doc comment; no test is skipped with the ignore attribute or expects a panic; no crate depends on a crate above
-//! it in the layering of docs/ARCHITECTURE.md.
+//! Repository hygiene, enforced by plain `cargo test`: every Rust file starts with a `//!` doc
+//! comment; no test is skipped with the ignore attribute or expects a panic; no crate depends on
+//! a crate above it in the layering table of docs/ARCHITECTURE.md, nor on an external crate
+//! confined to another layer there; every declared dependency is used.
 
 use std::path::{Path, PathBuf};
 
@@ -51,75 +52,105 @@ fn no_ignored_or_should_panic_tests() {
     assert!(offenders.is_empty(), "tests must run and assert real behaviour: {offenders:#?}");
 }
 
-/// Which workspace crates each crate may depend on (normal dependencies). The graph reads as
-/// the data flow; nothing points upward.
-const ALLOWED: &[(&str, &[&str])] = &[
-    ("tetgen-sys", &[]),
-    ("amber-mesh", &[]),
-    ("amber-testdata", &[]),
-    ("amber-meshgen", &["amber-mesh", "tetgen-sys"]),
-    ("amber-fem", &["amber-mesh", "amber-meshgen"]),
-    ("amber-graph", &["amber-mesh"]),
-    ("amber-metrics", &["amber-mesh"]),
-    ("amber-mpn", &["amber-graph"]),
-    ("amber-cnn", &["amber-mesh", "amber-meshgen", "amber-graph"]),
-    ("amber-tasks", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics"]),
-    (
-        "amber-train",
-        &[
-            "amber-mesh",
-            "amber-meshgen",
-            "amber-fem",
-            "amber-graph",
-            "amber-metrics",
-            "amber-mpn",
-            "amber-cnn",
-            "amber-tasks",
-        ],
-    ),
-    (
-        "amber-experiments",
-        &[
-            "amber-mesh",
-            "amber-meshgen",
-            "amber-fem",
-            "amber-graph",
-            "amber-metrics",
-            "amber-mpn",
-            "amber-cnn",
-            "amber-tasks",
-            "amber-train",
-        ],
-    ),
-    (
-        "amber-cli",
-        &[
-            "amber-mesh",
-            "amber-meshgen",
-            "amber-fem",
-            "amber-graph",
-            "amber-metrics",
-            "amber-tasks",
-            "amber-train",
-            "amber-experiments",
-        ],
-    ),
-];
+/// The rows of the markdown table under `heading` in docs/ARCHITECTURE.md, as (first cell, the
+/// back-quoted names of the second cell): the layering is written down once, for readers and for
+/// these tests.
+fn architecture_table(heading: &str) -> Vec<(String, Vec<String>)> {
+    let text = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let section = text.split(heading).nth(1).unwrap_or_else(|| panic!("docs/ARCHITECTURE.md has no `{heading}`"));
+    let names = |cell: &str| -> Vec<String> { cell.split('`').skip(1).step_by(2).map(str::to_string).collect() };
+    section
+        .lines()
+        .skip_while(|l| !l.starts_with('|'))
+        .take_while(|l| l.starts_with('|'))
+        .filter(|l| l.contains('`'))
+        .map(|l| {
+            let cells: Vec<&str> = l.split('|').collect();
+            (names(cells[1]).join(","), names(cells[2]))
+        })
+        .collect()
+}
+
+/// The dependency names of one section (`[dependencies]`, `[dev-dependencies]`, ...) of a
+/// manifest.
+fn manifest_deps(manifest: &str, section: &str) -> Vec<String> {
+    let header = format!("[{section}]");
+    let Some(body) = manifest.split(&header).nth(1) else { return Vec::new() };
+    body.split("\n[")
+        .next()
+        .unwrap_or("")
+        .lines()
+        .map(|l| l.split(['=', '.', '#']).next().unwrap().trim().to_string())
+        .filter(|d| !d.is_empty())
+        .collect()
+}
+
+/// Every crate of the workspace as (name, directory): crates/* and xtask.
+fn workspace_crates() -> Vec<(String, PathBuf)> {
+    let mut crates: Vec<(String, PathBuf)> = std::fs::read_dir(root().join("crates"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .map(|dir| (dir.file_name().unwrap().to_str().unwrap().to_string(), dir))
+        .collect();
+    crates.push(("xtask".into(), root().join("xtask")));
+    crates.sort();
+    crates
+}
+
+fn is_ours(dep: &str) -> bool {
+    dep.starts_with("amber-") || dep == "tetgen-sys"
+}
 
 #[test]
 fn crates_only_depend_downward() {
-    for entry in std::fs::read_dir(root().join("crates")).unwrap() {
-        let dir = entry.unwrap().path();
-        let name = dir.file_name().unwrap().to_str().unwrap().to_string();
-        let allowed = ALLOWED.iter().find(|(n, _)| *n == name).map(|(_, a)| *a);
-        let allowed =
-            allowed.unwrap_or_else(|| panic!("crate {name} is missing from the layering table in tests/tidy.rs"));
+    let layering = architecture_table("## Layering");
+    for (name, dir) in workspace_crates() {
+        let allowed = layering.iter().find(|(n, _)| *n == name).map(|(_, a)| a);
+        let allowed = allowed
+            .unwrap_or_else(|| panic!("crate {name} is missing from the layering table of docs/ARCHITECTURE.md"));
         let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
-        let deps = manifest.split("[dependencies]").nth(1).unwrap_or("").split("\n[").next().unwrap_or("");
-        for line in deps.lines() {
-            let dep = line.split(['=', '.']).next().unwrap().trim();
-            let is_ours = dep.starts_with("amber-") || dep == "tetgen-sys";
-            assert!(!is_ours || allowed.contains(&dep), "{name} must not depend on {dep} (see docs/ARCHITECTURE.md)");
+        for dep in manifest_deps(&manifest, "dependencies").into_iter().filter(|d| is_ours(d)) {
+            assert!(allowed.contains(&dep), "{name} must not depend on {dep} (see docs/ARCHITECTURE.md, Layering)");
+        }
+    }
+}
+
+#[test]
+fn external_crates_stay_in_their_layer() {
+    let confined = architecture_table("## External crates");
+    assert!(!confined.is_empty());
+    for (name, dir) in workspace_crates() {
+        let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
+        for dep in manifest_deps(&manifest, "dependencies") {
+            for (externals, owners) in &confined {
+                if externals.split(',').any(|e| e == dep) {
+                    assert!(owners.contains(&name), "{name} must not depend on {dep}: only {owners:?} may");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn every_declared_dependency_is_used() {
+    for (name, dir) in workspace_crates() {
+        let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
+        let mut files = Vec::new();
+        rust_files(&dir, &mut files);
+        if name == "xtask" {
+            rust_files(&root().join("tests"), &mut files);
+        }
+        let code: String = files.iter().map(|f| std::fs::read_to_string(f).unwrap()).collect();
+        for section in ["dependencies", "dev-dependencies", "build-dependencies"] {
+            for dep in manifest_deps(&manifest, section) {
+                let ident = dep.replace('-', "_");
+                assert!(
+                    code.contains(&format!("{ident}::"))
+                        || code.contains(&format!("use {ident}"))
+                        || code.contains(&format!("extern crate {ident}")),
+                    "{name}: [{section}] {dep} is declared but never used"
+                );
+            }
         }
     }
 }

@@ -6,9 +6,11 @@
 
 use std::path::PathBuf;
 
+use amber_experiments::{Task, amber_config};
 use amber_graph::Aggregation;
 use amber_tasks::poisson::read_split;
-use amber_train::{MeshLimits, MeshMetrics, Problem, Reference, StepOutcome, TrainingConfig, generation_step, labels};
+use amber_tasks::{MeshLimits, Problem, StepOutcome, generation_step, labels};
+use amber_train::{MeshMetrics, Reference};
 use anyhow::Context;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -58,7 +60,7 @@ struct Row {
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let missing = |dir: &PathBuf| format!("{}: run `cargo xtask dataset poisson` first", dir.display());
-    let config = TrainingConfig::quick();
+    let config = amber_config(Task::Poisson, amber_train::Profile::Quick);
     let train = read_split(&args.train).with_context(|| missing(&args.train))?;
     let train = &train[..config.data.train_problems.min(train.len())];
     let mut limits =

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use amber_experiments::{Method, merge_json, read_json, train_poisson};
+use amber_experiments::{Method, amber_config, merge_json, read_json, train_poisson};
 use amber_mesh::{MeshData, RenderOptions, render_png, write_mesh};
 use amber_tasks::poisson::{Difficulty, read_problem};
-use amber_train::{AmberModel, Evaluation, MODEL_DIR, Profile, StepStatus, TrainingConfig};
+use amber_train::{AmberModel, Evaluation, MODEL_DIR, Profile, StepStatus};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 
@@ -25,8 +25,8 @@ pub struct TrainArgs {
     #[arg(long, default_value = "quick")]
     profile: Profile,
     /// Expert refinement steps of the problems: easy (25), medium (50), hard (75).
-    #[arg(long)]
-    difficulty: Option<Difficulty>,
+    #[arg(long, default_value = "hard")]
+    difficulty: Difficulty,
     /// amber-mean or amber-max.
     #[arg(long, default_value = "amber-mean")]
     method: Method,
@@ -52,12 +52,9 @@ pub struct TrainArgs {
 
 pub fn train(args: TrainArgs) -> anyhow::Result<()> {
     let Task::Poisson = args.task;
-    let mut config = TrainingConfig::profile(args.profile);
+    let mut config = amber_config(amber_experiments::Task::Poisson, args.profile);
     config.aggregation = args.method.aggregation();
     config.seed = args.seed as u64;
-    if let Some(difficulty) = args.difficulty {
-        config.data.difficulty = difficulty;
-    }
     if let Some(path) = &args.config {
         let mut value = serde_json::to_value(&config)?;
         merge_json(&mut value, &read_json(path)?);
@@ -66,8 +63,8 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
     if let Some(steps) = args.steps {
         config.steps = steps;
     }
-    let label = format!("{} {} seed {}", args.method, config.data.difficulty, args.seed);
-    let seconds = train_poisson(&config, &args.data, &args.manifest, &args.out, &label)?;
+    let label = format!("{} {} seed {}", args.method, args.difficulty, args.seed);
+    let seconds = train_poisson(&config, args.difficulty, &args.data, &args.manifest, &args.out, &label)?;
     println!("trained in {seconds:.0} s; model in {}", args.out.join(MODEL_DIR).display());
     Ok(())
 }

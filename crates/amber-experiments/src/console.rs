@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use amber_mesh::{Mesh3, View};
 use amber_tasks::console::{ConsoleProblem, ConsoleSplit, INITIAL_MESH_RECIPE, TrainSet, has_test_split, part_names};
-use amber_train::{CnnConfig, Profile, TrainingConfig};
+use amber_train::Profile;
 use anyhow::bail;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -15,6 +15,7 @@ use serde::Serialize;
 use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
+use crate::profiles::{Task, amber_config, cnn_config};
 use crate::report::{commit, machine};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
@@ -73,26 +74,12 @@ impl ConsoleExperiment {
         }
     }
 
-    /// The configuration of one run: the profile's, with the Console task's settings (spec §9:
-    /// latent width 128, h_min at the 0.5 % quantile of the training experts' sizes), the
+    /// The configuration of one run: the Console task's profile (see [`amber_config`]), with the
     /// method's labels, the overrides and the seed.
     pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<RunConfig> {
         Ok(match spec.method {
             Method::AmberMean | Method::AmberMax => {
-                let mut config = TrainingConfig::profile(self.profile);
-                // The error indicator is a Poisson input: Console parts have no solution.
-                config.error_indicator_feature = false;
-                if self.profile != Profile::Smoke {
-                    config.network.latent_dim = 128;
-                }
-                if self.profile == Profile::Quick {
-                    // A batch is at least one whole part (1.4k–42k elements), and D = 128 trains at
-                    // ~8k nodes/s here: 800 steps took 16–20 minutes; 1,200 score better and
-                    // take ~25 per variant, 70 for the whole experiment alone (docs/PROFILES.md).
-                    config.steps = 1200;
-                    config.validation_interval = 400;
-                }
-                config.min_size_quantile = 0.005;
+                let mut config = amber_config(Task::Console, self.profile);
                 config.aggregation = spec.method.aggregation();
                 config.seed = seed as u64;
                 let config = spec.patched(&config, &self.overrides)?;
@@ -100,15 +87,7 @@ impl ConsoleExperiment {
                 RunConfig::Amber(config)
             }
             Method::Cnn { resolution } => {
-                let mut config = CnnConfig::profile(self.profile);
-                config.resolution = resolution;
-                if self.profile == Profile::Quick {
-                    // A 32³ step of 4 images took 1.9 s here, a 64³ step of 3 images 8.2 s: 9 and
-                    // 14 minutes of training.
-                    (config.steps, config.images_per_step) =
-                        if resolution <= 32 { (300, Some(4)) } else { (100, Some(3)) };
-                }
-                config.min_size_quantile = 0.005;
+                let mut config = cnn_config(Task::Console, self.profile, resolution);
                 config.aggregation = spec.method.aggregation();
                 config.seed = seed as u64;
                 let config = spec.patched(&config, &self.cnn_overrides)?;

@@ -5,14 +5,17 @@
 use std::path::{Path, PathBuf};
 
 use amber_mesh::Mesh2;
+use amber_tasks::LOG_SIZE_COLUMN;
+use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
 use amber_tasks::poisson::{Difficulty, PoissonProblem, Split, load_split, read_split};
-use amber_train::{CnnConfig, Profile, TrainingConfig};
+use amber_train::{Profile, TrainingConfig};
 use anyhow::bail;
 use serde::Serialize;
 
 use crate::method::{Method, MethodSpec, Variant};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
+use crate::profiles::{Task, amber_config, cnn_config};
 use crate::progress::item_bar;
 use crate::report::{commit, machine, merge_json, read_json};
 use crate::results::ExperimentResults;
@@ -94,7 +97,7 @@ impl PoissonExperiment {
         // The ablations vary the paper's choices on the paper's network and inputs: without the
         // graph context and the error-indicator feature of the quick profile.
         experiment.overrides =
-            serde_json::json!({ "network": { "graph_context": false }, "error_indicator_feature": false });
+            serde_json::json!({ "network": { "graph_context": false }, "inputs": [LOG_SIZE_COLUMN] });
         if profile == Profile::Quick {
             // Seventeen runs in three hours on two cores: each AMBER run gets 600 of the
             // reproduction's 2,500 steps (4–5 min of training on Poisson hard); the 256² CNNs
@@ -124,7 +127,11 @@ impl PoissonExperiment {
             variant(Method::AmberMax, "random-buffer", serde_json::json!({ "source_selection": "uniform" })),
             variant(Method::AmberMax, "no-input-normalisation", serde_json::json!({ "normalise_inputs": false })),
             variant(Method::AmberMean, "graph-context", serde_json::json!({ "network": { "graph_context": true } })),
-            variant(Method::AmberMean, "error-indicator", serde_json::json!({ "error_indicator_feature": true })),
+            variant(
+                Method::AmberMean,
+                "error-indicator",
+                serde_json::json!({ "inputs": [LOG_SIZE_COLUMN, LOG_ERROR_INDICATOR_COLUMN] }),
+            ),
         ];
         let cnn = Method::Cnn { resolution: if profile == Profile::Smoke { 32 } else { 256 } };
         experiment.methods.extend([
@@ -133,7 +140,7 @@ impl PoissonExperiment {
             variant(cnn, "plain-mse", serde_json::json!({ "loss": "mse", "normalise_labels": false })),
             variant(cnn, "max-labels", serde_json::json!({ "aggregation": "max" })),
         ]);
-        let default_problems = TrainingConfig::profile(profile).data.train_problems;
+        let default_problems = amber_config(Task::Poisson, profile).data.train_problems;
         let sizes: &[usize] = if profile == Profile::Smoke { &[1, 3] } else { &[5, 10, 50, 100] };
         for &n in sizes.iter().filter(|&&n| n != default_problems) {
             experiment.methods.push(variant(
@@ -146,24 +153,20 @@ impl PoissonExperiment {
     }
 
     /// The configuration of one run: the profile's, with the method's labels, the variant's and
-    /// the user's overrides (AMBER runs: `overrides`, CNN runs: `cnn_overrides`), the difficulty
-    /// and the seed.
-    pub fn run_config(&self, spec: &MethodSpec, difficulty: Difficulty, seed: usize) -> anyhow::Result<RunConfig> {
+    /// the user's overrides (AMBER runs: `overrides`, CNN runs: `cnn_overrides`) and the seed.
+    pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<RunConfig> {
         Ok(match spec.method {
             Method::AmberMean | Method::AmberMax => {
-                let mut config = TrainingConfig::profile(self.profile);
+                let mut config = amber_config(Task::Poisson, self.profile);
                 config.aggregation = spec.method.aggregation();
-                config.data.difficulty = difficulty;
                 config.seed = seed as u64;
                 let config = spec.patched(&config, &self.overrides)?;
                 config.validate()?;
                 RunConfig::Amber(config)
             }
             Method::Cnn { resolution } => {
-                let mut config = CnnConfig::profile(self.profile);
-                config.resolution = resolution;
+                let mut config = cnn_config(Task::Poisson, self.profile, resolution);
                 config.aggregation = spec.method.aggregation();
-                config.data.difficulty = difficulty;
                 config.seed = seed as u64;
                 let config = spec.patched(&config, &self.cnn_overrides)?;
                 config.validate()?;
@@ -187,8 +190,8 @@ impl PoissonExperiment {
             let mut rows: Vec<(String, Vec<Vec<Mesh2>>)> = Vec::new();
             for seed in 0..self.seeds {
                 for spec in &self.methods {
-                    let config = self.run_config(spec, difficulty, seed)?;
-                    let data_key = ("manifest", manifest.clone());
+                    let config = self.run_config(spec, seed)?;
+                    let data_key = ("data", serde_json::json!({ "manifest": manifest, "difficulty": difficulty }));
                     let run = Run::new(
                         &self.runs_root,
                         "poisson",
@@ -201,7 +204,9 @@ impl PoissonExperiment {
                     )?;
                     let evaluated =
                         run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| match &config {
-                            RunConfig::Amber(c) => train_poisson(c, &self.data_root, &self.manifest, dir, label),
+                            RunConfig::Amber(c) => {
+                                train_poisson(c, difficulty, &self.data_root, &self.manifest, dir, label)
+                            }
                             RunConfig::Cnn(c) => {
                                 let train = || self.load(difficulty, Split::Train, seed, c.data.train_problems);
                                 train_cnn(c, train, dir, label)
@@ -306,12 +311,13 @@ fn paper_number(row: &str, difficulty: &str) -> Option<f64> {
 /// progress lines.
 pub fn train_poisson(
     config: &TrainingConfig,
+    difficulty: Difficulty,
     data_root: &Path,
     manifest: &Path,
     dir: &Path,
     label: &str,
 ) -> anyhow::Result<f64> {
-    let (difficulty, seed) = (config.data.difficulty, config.seed as usize);
+    let seed = config.seed as usize;
     let problems = || {
         let train = load_problems(data_root, manifest, difficulty, Split::Train, seed, config.data.train_problems)?;
         let val = load_problems(data_root, manifest, difficulty, Split::Val, 0, config.data.val_problems)?;

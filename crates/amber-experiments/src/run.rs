@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use amber_mesh::{Mesh, MeshData, read_mesh, write_mesh};
+use amber_tasks::Problem;
 use amber_train::{
     AmberModel, CONFIG_FILE, CnnConfig, CnnModel, CnnObserver, CnnStepReport, CnnTraining, Evaluation,
-    EvaluationSummary, MODEL_DIR, Problem, Rollout, StepReport, Training, TrainingConfig, TrainingObserver,
+    EvaluationSummary, MODEL_DIR, Rollout, StepReport, Training, TrainingConfig, TrainingObserver,
 };
 use anyhow::{Context, bail};
 use serde::{Deserialize, Serialize};

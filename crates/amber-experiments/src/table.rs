@@ -10,11 +10,14 @@ use crate::results::{ExperimentResults, RunResult};
 /// the paper gives one.
 pub type PaperNumber = dyn Fn(&str, &str) -> Option<f64>;
 
-/// The runs of one (row, column) cell: all seeds.
-fn cells(results: &ExperimentResults) -> (Vec<String>, Vec<String>, BTreeMap<(String, String), Vec<&RunResult>>) {
+/// The runs of each (row, column) cell: all seeds.
+type Cells<'r> = BTreeMap<(String, String), Vec<&'r RunResult>>;
+
+/// The row labels, the column names and the cells of `results`, in the order of first appearance.
+fn cells(results: &ExperimentResults) -> (Vec<String>, Vec<String>, Cells<'_>) {
     let mut rows: Vec<String> = Vec::new();
     let mut columns: Vec<String> = Vec::new();
-    let mut cells: BTreeMap<(String, String), Vec<&RunResult>> = BTreeMap::new();
+    let mut cells = Cells::new();
     for run in &results.runs {
         let row = row_label(run);
         if !rows.contains(&row) {

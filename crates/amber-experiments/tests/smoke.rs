@@ -131,9 +131,9 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     assert_eq!(training(6)["amber"]["normalise_inputs"], false);
     // The ablations run on the paper's network and inputs, the graph context being a variant.
     assert_eq!(training(0)["amber"]["network"].get("graph_context"), None);
-    assert_eq!(training(0)["amber"].get("error_indicator_feature"), None);
+    assert_eq!(training(0)["amber"]["inputs"], serde_json::json!(["log_size"]));
     assert_eq!(training(7)["amber"]["network"]["graph_context"], true);
-    assert_eq!(training(8)["amber"]["error_indicator_feature"], true);
+    assert_eq!(training(8)["amber"]["inputs"], serde_json::json!(["log_size", "log_error_indicator"]));
     assert_eq!(training(10)["cnn"]["loss"], "softplus_mse");
     assert_eq!(training(11)["cnn"]["loss"], "mse");
     assert_eq!(training(12)["cnn"]["aggregation"], "max");

@@ -37,7 +37,7 @@ impl<const D: usize> Mesh<D> {
     fn build(vertices: Vec<[f64; D]>, mut cells: Vec<u32>, reorient: bool) -> Result<Self, MeshError> {
         const { assert!(D == 2 || D == 3, "meshes are 2D or 3D") };
         let n = D + 1;
-        if cells.len() % n != 0 {
+        if !cells.len().is_multiple_of(n) {
             return Err(MeshError::Connectivity { len: cells.len(), nodes_per_element: n });
         }
         if let Some(vertex) = vertices.iter().position(|p| p.iter().any(|c| !c.is_finite())) {

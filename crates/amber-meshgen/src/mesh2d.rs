@@ -92,11 +92,14 @@ pub fn uniform_mesh_2d(domain: &PolygonDomain, size: f64, params: &Mesh2dParams)
 
 /// Splits every boundary edge into `ceil(∫ds/h)` pieces of equal ∫ds/h (never longer than the
 /// field asks, as gmsh does). Returns the points and the boundary segments between them.
+/// The boundary's points and the segments between them (indices into the points).
+type BoundarySegments = (Vec<[f64; 2]>, Vec<[usize; 2]>);
+
 fn discretise_boundary(
     domain: &PolygonDomain,
     size: &impl Fn([f64; 2]) -> Result<f64, MeshgenError>,
     max_elements: usize,
-) -> Result<(Vec<[f64; 2]>, Vec<[usize; 2]>), MeshgenError> {
+) -> Result<BoundarySegments, MeshgenError> {
     let mut points = Vec::new();
     let mut segments = Vec::new();
     let mut samples: Vec<(f64, f64)> = Vec::new();
@@ -171,11 +174,11 @@ fn classify_faces(cdt: &Cdt) -> Vec<u8> {
     while let Some(f) = stack.pop() {
         let s = side[f.index()];
         for edge in cdt.face(f).adjacent_edges() {
-            if let Some(next) = edge.rev().face().as_inner() {
-                if side[next.fix().index()] == UNKNOWN {
-                    side[next.fix().index()] = s ^ u8::from(edge.is_constraint_edge());
-                    stack.push(next.fix());
-                }
+            if let Some(next) = edge.rev().face().as_inner()
+                && side[next.fix().index()] == UNKNOWN
+            {
+                side[next.fix().index()] = s ^ u8::from(edge.is_constraint_edge());
+                stack.push(next.fix());
             }
         }
     }
@@ -286,10 +289,10 @@ fn refine(
         vertex_size.push(size([point.x, point.y])?);
         classify_star(cdt, v, &mut side);
         for e in cdt.vertex(v).out_edges() {
-            if let Some(f) = e.face().as_inner() {
-                if side[f.fix().index()] == INSIDE {
-                    queue.push_back(f.fix());
-                }
+            if let Some(f) = e.face().as_inner()
+                && side[f.fix().index()] == INSIDE
+            {
+                queue.push_back(f.fix());
             }
         }
         if encroached.is_some() {

@@ -82,8 +82,8 @@ pub struct PixelGridSizing<const D: usize> {
 impl<const D: usize> SizingField<D> for PixelGridSizing<D> {
     fn size_at(&self, x: [f64; D]) -> f64 {
         let mut index = 0;
-        for k in 0..D {
-            let i = ((x[k] - self.origin[k]) / self.spacing[k]).floor();
+        for (k, &xk) in x.iter().enumerate() {
+            let i = ((xk - self.origin[k]) / self.spacing[k]).floor();
             let i = if i.is_nan() { 0 } else { (i.max(0.0) as usize).min(self.shape[k] - 1) };
             index = index * self.shape[k] + i;
         }

@@ -1,13 +1,21 @@
-//! Task definitions and their datasets. Today: the Poisson task of spec §1 — the random L-shape
-//! and Gaussian-mixture load ([`poisson::PoissonProblem`]), its initial mesh M⁰ and expert mesh
-//! M*, one JSON file per problem (readable from the reference's data format too), and the
-//! dataset splits of `datasets/poisson.json` with a content-hash cache.
+//! The learning tasks: what a task is ([`Problem`]: initial and expert mesh, input columns on any
+//! mesh of its domain, re-meshing from a sizing field), what every task shares (mesh states with
+//! their graphs, labels, one generation step under h_min and the element budget), and the tasks
+//! themselves beside their data. Poisson (spec §1): the random L-shape and Gaussian-mixture load,
+//! M⁰, the expert mesh, one JSON file per problem (readable from the reference's format too),
+//! the dataset splits of `datasets/poisson.json` with a content-hash cache. Console (spec §9): the
+//! expert `.nas` meshes and reference surfaces of the car-seat parts.
 //!
-//! Depends on the mesh, meshing and FEM layers; it knows nothing of graphs or learning, and never
-//! prints (progress is reported through a callback).
+//! Depends on the mesh, meshing, FEM, graph and metric layers; knows nothing of networks,
+//! training loops or candle, and never prints (progress is reported through a callback).
 
 pub mod console;
 mod error;
 pub mod poisson;
+mod problem;
 
 pub use error::TaskError;
+pub use problem::{
+    Column, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step, labels,
+    with_inputs,
+};

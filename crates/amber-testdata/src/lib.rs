@@ -1,7 +1,8 @@
 //! Where the tests find the shared data and fixtures (`../shared/` beside the workspace: the
 //! Console bundle, the independently computed reference values), and the one message a test
 //! prints when it skips because they are absent. `$AMBER_SHARED` points elsewhere, e.g. from a
-//! checkout that does not sit next to `shared/`. A dev-dependency only: no shipped code reads
+//! checkout that does not sit next to `shared/`; `AMBER_REQUIRE_SHARED=1` (set by CI, which has
+//! the folder) turns every such skip into a failure. A dev-dependency only: no shipped code reads
 //! data from a fixed place.
 
 use std::path::{Path, PathBuf};
@@ -14,13 +15,19 @@ fn shared_root() -> PathBuf {
 }
 
 /// `relative` (e.g. `data/console`) under the shared folder, or `None` after printing why the
-/// calling test skips.
+/// calling test skips; with `AMBER_REQUIRE_SHARED` set to anything but `0` an absent folder fails
+/// the calling test instead.
 pub fn shared(relative: &str) -> Option<PathBuf> {
     let path = shared_root().join(relative);
     if path.exists() {
-        Some(path)
-    } else {
-        println!("skipping: {} is absent (set AMBER_SHARED to the folder holding data/ and fixtures/)", path.display());
-        None
+        return Some(path);
     }
+    let why = format!("{} is absent (set AMBER_SHARED to the folder holding data/ and fixtures/)", path.display());
+    assert!(!required(), "AMBER_REQUIRE_SHARED is set: {why}");
+    println!("skipping: {why}");
+    None
+}
+
+fn required() -> bool {
+    std::env::var_os("AMBER_REQUIRE_SHARED").is_some_and(|v| v != "0")
 }

@@ -6,7 +6,9 @@ use std::collections::{BTreeSet, VecDeque};
 
 use rand::Rng;
 
-use crate::{MeshState, SourceSelection};
+use amber_tasks::MeshState;
+
+use crate::SourceSelection;
 
 /// A training graph: a mesh state with its labels and raw training targets.
 #[derive(Clone, Debug)]

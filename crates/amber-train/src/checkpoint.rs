@@ -26,7 +26,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, io_error};
 use crate::model::{tmp_path, write_atomic};
-use crate::{BufferEntry, Column, MeshState, Sample, TargetTransform, TrainingConfig};
+use amber_tasks::{Column, MeshState, Problem};
+
+use crate::{BufferEntry, Sample, TargetTransform, TrainingConfig};
 
 /// Sub-directory of the output directory holding the checkpoints.
 pub const CHECKPOINTS_DIR: &str = "checkpoints";
@@ -85,7 +87,7 @@ pub(crate) struct ProblemFingerprint {
 }
 
 /// The fingerprints of a run's training problems, checked on resume.
-pub(crate) fn fingerprints<const D: usize, P: crate::Problem<D>>(problems: &[P]) -> Vec<ProblemFingerprint> {
+pub(crate) fn fingerprints<const D: usize, P: Problem<D>>(problems: &[P]) -> Vec<ProblemFingerprint> {
     problems
         .iter()
         .map(|p| ProblemFingerprint {

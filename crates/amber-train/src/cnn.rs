@@ -17,6 +17,7 @@ use amber_cnn::{CnnLoss, PixelGrid, Raster, UNet, UNetConfig};
 use amber_graph::{Aggregation, GraphError, NodeFeature, RunningMoments, VARIANCE_EPSILON};
 use amber_mesh::Mesh;
 use amber_meshgen::SizingField;
+use amber_tasks::{MeshLimits, Problem, StepOutcome, generation_step, labels};
 use candle_core::{DType, Device, Tensor};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -26,10 +27,7 @@ use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STAT
 use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::model::{read_json, write_json};
 use crate::optim::Adam;
-use crate::{
-    BufferEntry, DataConfig, MeshLimits, MeshMetrics, Problem, Profile, Reference, Rollout, RolloutStep, StepOutcome,
-    StepStatus, generation_step, labels,
-};
+use crate::{BufferEntry, DataConfig, MeshMetrics, Profile, Reference, Rollout, RolloutStep, StepStatus};
 
 /// File of the U-Net weights (and BatchNorm statistics) inside a CNN model directory.
 pub const CNN_WEIGHTS_FILE: &str = "cnn.safetensors";
@@ -104,8 +102,8 @@ impl CnnConfig {
         }
     }
 
-    /// Two CPU cores: the paper's text width (32 channels), 2 random images per step (400 steps
-    /// of 256² images took 9 minutes here), standardised log-size targets and learning rate 1e-3,
+    /// Two CPU cores: the paper's text width (32 channels), 2 random images per step,
+    /// standardised log-size targets and learning rate 1e-3,
     /// which spare the hundreds of steps the output layer otherwise needs just to reach log sizes
     /// around −5.
     pub fn quick() -> Self {
@@ -123,7 +121,7 @@ impl CnnConfig {
     /// For CI: two easy problems on a 32² grid, a narrow network, a few steps.
     pub fn smoke() -> Self {
         Self {
-            data: DataConfig { train_problems: 2, val_problems: 2, ..DataConfig::default() },
+            data: DataConfig { train_problems: 2, val_problems: 2 },
             resolution: 32,
             initial_channels: 8,
             steps: 20,
@@ -685,7 +683,7 @@ mod tests {
     use amber_mesh::Mesh3;
     use amber_tasks::poisson::{INITIAL_SIZE, PoissonProblem};
 
-    use crate::{Column, ProblemError};
+    use amber_tasks::{Column, ProblemError};
 
     /// Poisson problems with small experts (8 refinement steps).
     fn poisson(seeds: &[u64]) -> Vec<PoissonProblem> {

@@ -5,7 +5,6 @@ use std::fmt;
 use std::str::FromStr;
 
 use amber_graph::Aggregation;
-use amber_tasks::poisson::Difficulty;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError};
@@ -93,12 +92,11 @@ impl Default for NetworkConfig {
     }
 }
 
-/// Which dataset files a run reads (the loops themselves take problems, not paths).
+/// How many of a task's problems a run reads (which task and files is the caller's to say; the
+/// loops themselves take problems, not paths).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DataConfig {
-    /// Expert refinement steps of the Poisson problems.
-    pub difficulty: Difficulty,
     /// Training problems (a prefix of the split).
     pub train_problems: usize,
     /// Validation problems used during training (a prefix of the split).
@@ -107,7 +105,7 @@ pub struct DataConfig {
 
 impl Default for DataConfig {
     fn default() -> Self {
-        Self { difficulty: Difficulty::Hard, train_problems: 20, val_problems: 20 }
+        Self { train_problems: 20, val_problems: 20 }
     }
 }
 
@@ -128,21 +126,10 @@ pub struct TrainingConfig {
     pub normalise_labels: bool,
     /// Normalise node and edge features by their running moments (off: the ablation).
     pub normalise_inputs: bool,
-    /// Append log h(K) to the task's node features (see [`crate::with_log_size`]); not in the
-    /// paper.
-    pub log_size_feature: bool,
-    /// Append the log-scaled load to the node features (see [`crate::with_log_load`]; Poisson
-    /// only); not in the paper, and no gain at 3,000 quick steps (docs/PROFILES.md). Left out of
-    /// the serialised config when off, so the configs (and cache keys) of runs without it are
-    /// unchanged.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub log_load_feature: bool,
-    /// Append ln η_K, the expert's residual error indicator on the current mesh (see
-    /// [`crate::with_error_indicator`]; Poisson only); not in the paper. Left out of the
-    /// serialised config when off, so configurations without it keep their hashes; hence absent
-    /// means off, not the quick profile's on.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub error_indicator_feature: bool,
+    /// Extra node inputs appended in order to the task's features, by column name: `log_size`
+    /// (log h(K), any task) or one of the task's optional inputs
+    /// (`amber_tasks::Problem::optional_inputs`); none in the paper.
+    pub inputs: Vec<String>,
     /// The network.
     pub network: NetworkConfig,
     /// Gradient steps.
@@ -195,9 +182,7 @@ impl TrainingConfig {
             objective: Objective::Softplus,
             normalise_labels: false,
             normalise_inputs: true,
-            log_size_feature: false,
-            log_load_feature: false,
-            error_indicator_feature: false,
+            inputs: Vec::new(),
             network: NetworkConfig::default(),
             steps: 128_000,
             learning_rate: 3e-4,
@@ -217,22 +202,17 @@ impl TrainingConfig {
     }
 
     /// The default: the best quality reachable within about 30 minutes of training per variant
-    /// on two CPU cores, on the paper's data (Poisson hard). The later version's levers (§11):
-    /// residual in softplus space with normalised labels, learning rate 1e-3 with 5 % warm-up and
-    /// linear decay; plus the log-size node feature, the network's graph context and (Poisson) the
-    /// error-indicator feature. Small batches (12,000 nodes, about one generated mesh) so that
-    /// many steps fit, an addition every 4 steps so the buffer fills with the model's own meshes
-    /// early, a 500-entry buffer. Measured (docs/PROFILES.md, AMBER-Mean, Poisson hard, test
-    /// normalised DCD): 600, 2,000 and 3,000 steps gave 0.369, 0.339 and 0.324 on the paper's
-    /// inputs, 0.277 with the graph context at 3,000, 0.115 with the error indicator too, and
-    /// 0.118 at 2,500; without the log-size feature validation was 0.453 instead of 0.324;
-    /// learning rate 2e-3, the log objective and a log-load feature did not help.
+    /// on two CPU cores. The later version's levers (§11): residual in softplus space with
+    /// normalised labels, learning rate 1e-3 with 5 % warm-up and linear decay; plus the log-size
+    /// input and the network's graph context. Small batches (12,000 nodes, about one generated
+    /// mesh) so that many steps fit, an addition every 4 steps so the buffer fills with the
+    /// model's own meshes early, a 500-entry buffer. Tasks adjust it (amber-experiments'
+    /// profile table); the evidence is in docs/PROFILES.md.
     pub fn quick() -> Self {
         Self {
             objective: Objective::SoftplusResidual,
             normalise_labels: true,
-            log_size_feature: true,
-            error_indicator_feature: true,
+            inputs: vec![amber_tasks::LOG_SIZE_COLUMN.into()],
             network: NetworkConfig { graph_context: true, ..NetworkConfig::default() },
             steps: 2_500,
             learning_rate: 1e-3,
@@ -250,7 +230,7 @@ impl TrainingConfig {
     /// of the loop (additions, eviction, checkpoints, validation) runs at least once.
     pub fn smoke() -> Self {
         Self {
-            data: DataConfig { difficulty: Difficulty::Easy, train_problems: 2, val_problems: 2 },
+            data: DataConfig { train_problems: 2, val_problems: 2 },
             network: NetworkConfig { latent_dim: 32, message_passing_steps: 4, ..Self::quick().network },
             steps: 200,
             batch_nodes: 4_000,
@@ -368,13 +348,8 @@ mod tests {
             assert_eq!(profile.name().parse::<Profile>().unwrap(), profile);
         }
         let partial: TrainingConfig = serde_json::from_str(r#"{"steps": 10, "aggregation": "max"}"#).unwrap();
-        let expected = TrainingConfig {
-            steps: 10,
-            aggregation: Aggregation::Max,
-            error_indicator_feature: false,
-            ..TrainingConfig::quick()
-        };
-        assert_eq!(partial, expected, "absent fields are the quick profile's, but an absent optional input is off");
+        let expected = TrainingConfig { steps: 10, aggregation: Aggregation::Max, ..TrainingConfig::quick() };
+        assert_eq!(partial, expected, "absent fields are the quick profile's");
         assert!(serde_json::from_str::<TrainingConfig>(r#"{"stepz": 10}"#).is_err());
         let bad = TrainingConfig { objective: Objective::Softplus, normalise_labels: true, ..TrainingConfig::quick() };
         assert!(bad.validate().is_err());

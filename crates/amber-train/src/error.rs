@@ -4,8 +4,7 @@ use std::path::PathBuf;
 
 use amber_graph::GraphError;
 use amber_mpn::MpnError;
-
-use crate::ProblemError;
+use amber_tasks::ProblemError;
 
 /// Everything that can go wrong training AMBER or rolling it out.
 #[derive(Debug, thiserror::Error)]

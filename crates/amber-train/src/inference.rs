@@ -9,7 +9,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, in_problem};
-use crate::{MeshLimits, MeshState, Predictor, Problem, ProblemError, StepOutcome, generation_step};
+use amber_tasks::{MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step};
+
+use crate::Predictor;
 
 /// Predictions are made in batches of at most this many nodes (a rollout over many large
 /// problems would not fit one batch in memory).

@@ -1,5 +1,4 @@
-//! AMBER's training and inference loops, above every other layer: the task abstraction
-//! ([`Problem`], implemented for the Poisson task), the replay buffer with least-used batching
+//! AMBER's training and inference loops, for any task (`amber_tasks::Problem`): the replay buffer with least-used batching
 //! and stratified additions, running input and label normalisation, the training loop with
 //! checkpoints that resume exactly and a JSON-lines log, and rollouts of a trained model with
 //! their metrics against the expert.
@@ -17,13 +16,11 @@ mod buffer;
 mod checkpoint;
 mod cnn;
 mod config;
-mod console;
 mod error;
 mod inference;
 mod model;
 mod optim;
 mod target;
-mod task;
 mod train;
 
 pub use buffer::{BufferEntry, ReplayBuffer, Sample};
@@ -40,8 +37,4 @@ pub use inference::{
 pub use model::{AmberModel, Predictor, WEIGHTS_FILE};
 pub use optim::Adam;
 pub use target::{TargetTransform, softplus, softplus_inverse};
-pub use task::{
-    Column, LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError,
-    StepOutcome, generation_step, labels, with_error_indicator, with_log_load, with_log_size,
-};
 pub use train::{Addition, CONFIG_FILE, LOG_FILE, MODEL_DIR, StepReport, Training, TrainingObserver};

@@ -9,7 +9,9 @@ use candle_core::{DType, Device};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, io_error};
-use crate::{MeshLimits, MeshState, TargetTransform};
+use amber_tasks::{MeshLimits, MeshState};
+
+use crate::TargetTransform;
 
 /// File of the network weights inside a model directory (its config is `model.json`).
 pub const WEIGHTS_FILE: &str = "model.safetensors";

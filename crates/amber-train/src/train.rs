@@ -9,6 +9,9 @@ use std::time::Instant;
 use amber_graph::{FeatureNormaliser, GraphBatch};
 use amber_mesh::Mesh;
 use amber_mpn::{GraphInput, Mpn, MpnConfig};
+use amber_tasks::{
+    LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step, labels, with_inputs,
+};
 use candle_core::{DType, Device, Tensor};
 use candle_nn::VarMap;
 use rand_chacha::ChaCha8Rng;
@@ -22,9 +25,7 @@ use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::model::{WEIGHTS_FILE, read_json, write_json};
 use crate::optim::Adam;
 use crate::{
-    AmberModel, Evaluation, EvaluationSummary, MeshLimits, MeshState, Predictor, Problem, ProblemError, ReplayBuffer,
-    Sample, StepOutcome, TargetTransform, TrainingConfig, generation_step, labels, with_error_indicator, with_log_load,
-    with_log_size,
+    AmberModel, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, TargetTransform, TrainingConfig,
 };
 
 /// The final model's sub-directory of the output directory.
@@ -107,16 +108,14 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
     pub fn new(config: TrainingConfig, problems: Vec<P>) -> Result<Self> {
         config.validate()?;
         let first = problems.first().ok_or(TrainError::NoProblems)?;
-        let mut features = first.feature_set();
-        if config.log_size_feature {
-            features = with_log_size(features);
+        let offered = first.optional_inputs();
+        if let Some(unknown) = config.inputs.iter().find(|i| *i != LOG_SIZE_COLUMN && !offered.contains(&i.as_str())) {
+            return Err(TrainError::InvalidConfig(format!(
+                "inputs: the task offers no input `{unknown}` (it offers {LOG_SIZE_COLUMN}{})",
+                offered.iter().map(|o| format!(", {o}")).collect::<String>()
+            )));
         }
-        if config.log_load_feature {
-            features = with_log_load(features);
-        }
-        if config.error_indicator_feature {
-            features = with_error_indicator(features);
-        }
+        let features = with_inputs(first.feature_set(), &config.inputs);
         let limits = MeshLimits::from_experts(
             problems.iter().map(|p| p.expert_mesh()),
             config.budget_factor,

@@ -5,7 +5,8 @@
 use std::path::Path;
 
 use amber_fem::ExpertHeuristic;
-use amber_tasks::poisson::{Difficulty, INITIAL_SIZE, PoissonProblem};
+use amber_tasks::LOG_SIZE_COLUMN;
+use amber_tasks::poisson::{INITIAL_SIZE, LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, PoissonProblem};
 use amber_train::{
     AmberModel, DataConfig, Evaluation, MODEL_DIR, NetworkConfig, Predictor, ReplayBuffer, StepReport, StepStatus,
     Training, TrainingConfig, TrainingObserver, rollouts,
@@ -18,7 +19,7 @@ fn problems(seeds: &[u64]) -> Vec<PoissonProblem> {
 
 fn tiny_config(steps: u64) -> TrainingConfig {
     TrainingConfig {
-        data: DataConfig { difficulty: Difficulty::Easy, train_problems: 2, val_problems: 1 },
+        data: DataConfig { train_problems: 2, val_problems: 1 },
         network: NetworkConfig { latent_dim: 16, message_passing_steps: 3, ..NetworkConfig::default() },
         steps,
         batch_nodes: 1_500,
@@ -217,16 +218,16 @@ fn rollouts_return_every_mesh_with_finite_metrics() {
 #[test]
 fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
     let problem = problems(&[3]).remove(0);
-    let m0 = amber_train::Problem::initial_mesh(&problem).clone();
-    let mut limits = amber_train::MeshLimits { min_size: 1e-6, max_elements: 2_000, scale_to_budget: false };
+    let m0 = amber_tasks::Problem::initial_mesh(&problem).clone();
+    let mut limits = amber_tasks::MeshLimits { min_size: 1e-6, max_elements: 2_000, scale_to_budget: false };
     // 0.005 everywhere asks for ~70k triangles on the L-shape.
     let fine = vec![0.005; m0.num_elements()];
-    let outcome = amber_train::generation_step(&problem, &m0, fine.clone(), &limits);
+    let outcome = amber_tasks::generation_step(&problem, &m0, fine.clone(), &limits);
     assert!(
-        matches!(outcome, amber_train::StepOutcome::OverBudget { estimated_elements } if estimated_elements > 50_000.0)
+        matches!(outcome, amber_tasks::StepOutcome::OverBudget { estimated_elements } if estimated_elements > 50_000.0)
     );
     limits.scale_to_budget = true;
-    let amber_train::StepOutcome::Meshed(mesh) = amber_train::generation_step(&problem, &m0, fine, &limits) else {
+    let amber_tasks::StepOutcome::Meshed(mesh) = amber_tasks::generation_step(&problem, &m0, fine, &limits) else {
         panic!("a field scaled to the budget is meshed")
     };
     let n = mesh.num_elements();
@@ -235,7 +236,8 @@ fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
 
 #[test]
 fn the_optional_features_reach_a_saved_model_that_predicts_on_new_meshes() {
-    let config = TrainingConfig { log_load_feature: true, error_indicator_feature: true, ..tiny_config(3) };
+    let inputs = [LOG_SIZE_COLUMN, LOG_LOAD_COLUMN, LOG_ERROR_INDICATOR_COLUMN].map(String::from).to_vec();
+    let config = TrainingConfig { inputs, ..tiny_config(3) };
     let problems = problems(&[11, 12]);
     let mut training = Training::new(config, problems.clone()).unwrap();
     for _ in 0..3 {
@@ -245,13 +247,13 @@ fn the_optional_features_reach_a_saved_model_that_predicts_on_new_meshes() {
     training.save_model(dir.path()).unwrap();
     let model = AmberModel::load(dir.path()).unwrap();
     let names: Vec<String> = model.predictor.features.node.iter().map(|f| format!("{f:?}")).collect();
-    assert!(names.iter().any(|n| n.contains(amber_train::LOG_SIZE_COLUMN)), "{names:?}");
-    assert!(names.iter().any(|n| n.contains(amber_train::LOG_LOAD_COLUMN)), "{names:?}");
-    assert!(names.iter().any(|n| n.contains(amber_train::LOG_ERROR_INDICATOR_COLUMN)), "{names:?}");
+    assert!(names.iter().any(|n| n.contains(LOG_SIZE_COLUMN)), "{names:?}");
+    assert!(names.iter().any(|n| n.contains(LOG_LOAD_COLUMN)), "{names:?}");
+    assert!(names.iter().any(|n| n.contains(LOG_ERROR_INDICATOR_COLUMN)), "{names:?}");
     assert_eq!(model.network.config().node_features, 7, "the paper's 4 node features + 3");
 
     let problem = &problems[0];
-    let state = amber_train::MeshState::new(problem, &model.predictor.features, problem.expert_mesh.clone()).unwrap();
+    let state = amber_tasks::MeshState::new(problem, &model.predictor.features, problem.expert_mesh.clone()).unwrap();
     let sizes = model.predict(&[&state]).unwrap();
     assert_eq!(sizes[0].len(), problem.expert_mesh.num_elements());
     assert!(sizes[0].iter().all(|h| h.is_finite() && *h > 0.0));

@@ -13,6 +13,8 @@
 //! The paper trains on train/001–015, validates on val/001–002 and tests on test/001–005;
 //! [`TrainSet::All`] trains on all 19.
 
+mod problem;
+
 use std::path::{Path, PathBuf};
 
 use amber_mesh::{Mesh3, MeshError, read_mesh};

@@ -7,9 +7,9 @@ use amber_graph::FeatureSet;
 use amber_mesh::Mesh;
 use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
 use amber_meshgen::{MeshSizing, MeshgenError};
-use amber_tasks::console::ConsoleProblem;
 
-use crate::task::{Column, Problem, ProblemError};
+use super::ConsoleProblem;
+use crate::problem::{Column, Problem, ProblemError};
 
 impl Problem<3> for ConsoleProblem {
     fn feature_set(&self) -> FeatureSet {
@@ -39,10 +39,10 @@ impl Problem<3> for ConsoleProblem {
 #[cfg(test)]
 mod tests {
     use amber_graph::Aggregation;
-    use amber_tasks::console::ConsoleSplit;
 
     use super::*;
-    use crate::task::{MeshLimits, MeshState, StepOutcome, generation_step, labels};
+    use crate::console::ConsoleSplit;
+    use crate::problem::{MeshLimits, MeshState, StepOutcome, generation_step, labels};
 
     /// One generation step on val/002 from M⁰ with a smoke-size field (3 mm everywhere): a new
     /// mesh of the same solid with about the expected element count, its graph and labels; and a

@@ -1,16 +1,15 @@
-//! What the loops need to know about a learning task: a [`Problem`] has an initial and an expert
-//! mesh, computes its per-element input columns on any mesh of its domain, and re-meshes its
-//! domain from a per-element sizing field. The Poisson task is implemented; the Console (3D)
-//! task plugs in by implementing [`Problem<3>`].
+//! What the training and inference loops need to know about a learning task: a [`Problem`] has an
+//! initial and an expert mesh, computes its per-element input columns on any mesh of its domain,
+//! and re-meshes its domain from a per-element sizing field. Around it, what every task shares: a
+//! mesh with its columns and graph ([`MeshState`]), the labels (the expert's sizing field projected
+//! onto a mesh), and one generation step under h_min and the element budget ([`MeshLimits`]).
+//! Each task implements the trait beside its data (`poisson`, `console`).
 
-use amber_fem::{ExpertHeuristic, FemError, P1Space, Quadrature, element_stats};
+use amber_fem::FemError;
 use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, NodeFeature, project_expert_sizing};
 use amber_mesh::Mesh;
-use amber_meshgen::{
-    Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, estimated_element_count, generate_2d, quantile,
-};
+use amber_meshgen::{MeshgenError, estimated_element_count, quantile};
 use amber_metrics::MetricsError;
-use amber_tasks::poisson::PoissonProblem;
 use serde::{Deserialize, Serialize};
 
 /// Why one problem's step failed.
@@ -43,6 +42,11 @@ pub struct Column {
 pub trait Problem<const D: usize>: Sync {
     /// The node and edge features of this task's graphs (the same for all its problems).
     fn feature_set(&self) -> FeatureSet;
+    /// Names of the columns this task computes beyond its feature set, which a model may take as
+    /// extra node inputs (see [`with_inputs`]); [`LOG_SIZE_COLUMN`] is offered by every task.
+    fn optional_inputs(&self) -> &'static [&'static str] {
+        &[]
+    }
     /// M⁰, the start of every rollout.
     fn initial_mesh(&self) -> &Mesh<D>;
     /// M*, the expert's mesh the labels come from.
@@ -53,53 +57,6 @@ pub trait Problem<const D: usize>: Sync {
     /// A new mesh of the domain whose element sizes follow the piecewise-constant field `sizes`
     /// on `mesh`; the generator refuses to build more than `max_elements` elements.
     fn remesh(&self, mesh: &Mesh<D>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<D>, ProblemError>;
-}
-
-impl Problem<2> for PoissonProblem {
-    fn feature_set(&self) -> FeatureSet {
-        FeatureSet::poisson()
-    }
-
-    fn initial_mesh(&self) -> &Mesh<2> {
-        &self.initial_mesh
-    }
-
-    fn expert_mesh(&self) -> &Mesh<2> {
-        &self.expert_mesh
-    }
-
-    /// Solves −Δu = f (P1) on `mesh`: `solution_mean`, `solution_std` of u over each element's
-    /// vertices, `load` = f at the element midpoint, and ln η_K (read only by
-    /// [`with_error_indicator`]).
-    fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-        let order = self
-            .metadata
-            .heuristic
-            .as_ref()
-            .map_or(ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order);
-        let space = P1Space::new(mesh)?;
-        let quadrature = Quadrature::simplex::<2>(order)?;
-        let samples = space.sample_load(&self.load, &quadrature)?;
-        let solution = space.solve_poisson(&samples)?;
-        let stats = element_stats(mesh, &solution.u)?;
-        let indicator = space.residual_estimator(&solution.u, &samples)?;
-        let load = mesh.midpoints().into_iter().map(|x| amber_fem::Load::value(&self.load, x)).collect();
-        Ok(vec![
-            Column { name: "solution_mean".into(), values: stats.iter().map(|s| s.mean).collect() },
-            Column { name: "solution_std".into(), values: stats.iter().map(|s| s.std).collect() },
-            Column { name: "load".into(), values: load },
-            Column {
-                name: LOG_ERROR_INDICATOR_COLUMN.into(),
-                values: indicator.iter().map(|eta| eta.max(f64::MIN_POSITIVE).ln()).collect(),
-            },
-        ])
-    }
-
-    fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
-        let domain = PolygonDomain::lshape(self.corner)?;
-        let params = Mesh2dParams::default().with_max_elements(max_elements);
-        Ok(generate_2d(&domain, &MeshSizing::new(mesh, sizes), &params)?)
-    }
 }
 
 /// The clip and the element budget every predicted sizing field passes before meshing (spec
@@ -154,44 +111,23 @@ pub struct MeshState<const D: usize> {
     pub graph: MeshGraph,
 }
 
-/// Name of the optional node feature log h(K) (see [`with_log_size`]).
-pub const LOG_SIZE_COLUMN: &str = "log_size";
-
-/// `features` with the node feature log h(K) appended: normalised linearly, raw element areas
+/// Name of the generic optional node input log h(K): normalised linearly, raw element volumes
 /// that span many orders of magnitude (10⁻¹ to 10⁻¹² on the hard Poisson meshes) cannot tell the
 /// small elements apart, yet the size of the current element is what a prediction relative to it
-/// needs most.
-pub fn with_log_size(mut features: FeatureSet) -> FeatureSet {
-    features.node.push(NodeFeature::Column(LOG_SIZE_COLUMN.into()));
-    features
-}
+/// needs most. Any task offers it; [`MeshState::new`] computes it.
+pub const LOG_SIZE_COLUMN: &str = "log_size";
 
-/// Name of the optional node feature sign(f)·ln(1 + |f|) of the Poisson load f (see
-/// [`with_log_load`]).
-pub const LOG_LOAD_COLUMN: &str = "log_load";
-
-/// `features` with the log-scaled load appended: the load has peaks of 10²–10³ over a background
-/// near 0, so after linear normalisation every element off a peak looks alike, yet the expert
-/// refines well into the flanks. Derived from the task's `load` column (Poisson only).
-pub fn with_log_load(mut features: FeatureSet) -> FeatureSet {
-    features.node.push(NodeFeature::Column(LOG_LOAD_COLUMN.into()));
-    features
-}
-
-/// Name of the Poisson column ln η_K (see [`with_error_indicator`]).
-pub const LOG_ERROR_INDICATOR_COLUMN: &str = "log_error_indicator";
-
-/// `features` with ln η_K appended (Poisson only): the residual error indicator of the current
-/// solution, the quantity the expert's refinement loop marks by. An adaptive solver computes it
-/// anyway; the network still has to learn where 75 marking rounds end up from one estimate.
-pub fn with_error_indicator(mut features: FeatureSet) -> FeatureSet {
-    features.node.push(NodeFeature::Column(LOG_ERROR_INDICATOR_COLUMN.into()));
+/// `features` with the optional node inputs `inputs` appended in order: column names that the
+/// task computes beyond its own feature set (see [`Problem::optional_inputs`]), or
+/// [`LOG_SIZE_COLUMN`].
+pub fn with_inputs(mut features: FeatureSet, inputs: &[String]) -> FeatureSet {
+    features.node.extend(inputs.iter().map(|name| NodeFeature::Column(name.clone())));
     features
 }
 
 impl<const D: usize> MeshState<D> {
-    /// Computes the columns of `mesh` that `features` needs from `problem` (plus log h(K) and
-    /// the log-scaled load if asked for) and builds its graph.
+    /// Computes the columns of `mesh` from `problem` (plus log h(K) if `features` asks for it)
+    /// and builds its graph.
     pub fn new<P: Problem<D> + ?Sized>(
         problem: &P,
         features: &FeatureSet,
@@ -201,11 +137,6 @@ impl<const D: usize> MeshState<D> {
         if features.node.iter().any(|f| *f == NodeFeature::Column(LOG_SIZE_COLUMN.into())) {
             let values = mesh.sizes().into_iter().map(f64::ln).collect();
             columns.push(Column { name: LOG_SIZE_COLUMN.into(), values });
-        }
-        let log_load = features.node.iter().any(|f| *f == NodeFeature::Column(LOG_LOAD_COLUMN.into()));
-        if let Some(load) = columns.iter().find(|c| c.name == "load").filter(|_| log_load) {
-            let values = load.values.iter().map(|f| f.signum() * f.abs().ln_1p()).collect();
-            columns.push(Column { name: LOG_LOAD_COLUMN.into(), values });
         }
         Self::from_columns(features, mesh, columns)
     }

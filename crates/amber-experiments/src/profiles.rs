@@ -1,0 +1,74 @@
+//! The one place where a task adjusts the generic profiles of `amber-train`: every delta of a
+//! task's run configuration from [`TrainingConfig::profile`] and [`CnnConfig::profile`], keyed
+//! by task, method and profile. Experiments and the `amber` command start from these; variants
+//! and the user's overrides are merged on top (see [`crate::MethodSpec`]). Why each value is what
+//! it is: docs/PROFILES.md.
+
+use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
+use amber_train::{CnnConfig, Profile, TrainingConfig};
+use serde::{Deserialize, Serialize};
+
+/// A learning task of the paper.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Task {
+    /// 2D Poisson on random L-shapes (spec §1).
+    Poisson,
+    /// The 3D Console car-seat parts (spec §9).
+    Console,
+}
+
+/// AMBER's configuration of `task` under `profile` (before the method's labels and the seed).
+pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
+    let mut config = TrainingConfig::profile(profile);
+    match (task, profile) {
+        (Task::Poisson, Profile::Paper) => {}
+        // ln η_K: 0.324 → 0.118 on Poisson hard at quick scale; not one of the paper's inputs.
+        (Task::Poisson, Profile::Smoke | Profile::Quick) => config.inputs.push(LOG_ERROR_INDICATOR_COLUMN.into()),
+        (Task::Console, _) => {
+            // Spec §9: latent width 128, h_min at the 0.5 % quantile of the training experts' sizes.
+            config.min_size_quantile = 0.005;
+            if profile != Profile::Smoke {
+                config.network.latent_dim = 128;
+            }
+            if profile == Profile::Quick {
+                // A batch is at least one whole part (1.4k–42k elements): fewer, slower steps.
+                config.steps = 1_200;
+                config.validation_interval = 400;
+            }
+        }
+    }
+    config
+}
+
+/// The U-Net's configuration of `task` under `profile` on a `resolution`ᴰ grid.
+pub fn cnn_config(task: Task, profile: Profile, resolution: usize) -> CnnConfig {
+    let mut config = CnnConfig::profile(profile);
+    config.resolution = resolution;
+    if task == Task::Console {
+        config.min_size_quantile = 0.005;
+        if profile == Profile::Quick {
+            // 9 and 14 minutes of training for 32³ and 64³ on two cores.
+            (config.steps, config.images_per_step) = if resolution <= 32 { (300, Some(4)) } else { (100, Some(3)) };
+        }
+    }
+    config
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_task_and_profile_gives_a_valid_config() {
+        for task in [Task::Poisson, Task::Console] {
+            for profile in Profile::ALL {
+                amber_config(task, profile).validate().unwrap();
+                cnn_config(task, profile, 32).validate().unwrap();
+            }
+        }
+        assert!(amber_config(Task::Poisson, Profile::Quick).inputs.iter().any(|i| i == LOG_ERROR_INDICATOR_COLUMN));
+        assert!(amber_config(Task::Console, Profile::Quick).inputs.iter().all(|i| i != LOG_ERROR_INDICATOR_COLUMN));
+        assert!(amber_config(Task::Poisson, Profile::Paper).inputs.is_empty());
+    }
+}
