@@ -8,9 +8,6 @@ use amber_mesh::MeshError;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum GraphError {
-    /// A mesh has no elements. `which` names the argument.
-    #[error("the {which} mesh has no elements")]
-    EmptyMesh { which: &'static str },
     /// The mesh is not a valid element graph (e.g. a facet shared by three elements).
     #[error(transparent)]
     Mesh(#[from] MeshError),

@@ -39,9 +39,6 @@ impl MeshGraph {
         columns: &[ElementColumn<'_>],
     ) -> Result<Self, GraphError> {
         let n = mesh.num_elements();
-        if n == 0 {
-            return Err(GraphError::EmptyMesh { which: "graph" });
-        }
         let adjacency = FacetAdjacency::new(mesh)?;
         let num_edges = n + 2 * adjacency.num_interior_facets();
         if num_edges > u32::MAX as usize {
@@ -238,7 +235,5 @@ mod tests {
         let nan = [1.0, f64::NAN, 0.0, 0.0];
         let columns = [ElementColumn { name: "u", values: &nan }];
         assert!(matches!(MeshGraph::new(&m, &set, &columns), Err(GraphError::NonFiniteColumn { element: 1, .. })));
-        let empty = Mesh2::new(vec![], vec![]).unwrap();
-        assert!(matches!(MeshGraph::new(&empty, &set, &[]), Err(GraphError::EmptyMesh { .. })));
     }
 }

@@ -35,12 +35,6 @@ pub fn project_expert_sizing<const D: usize>(
     expert: &Mesh<D>,
     aggregation: Aggregation,
 ) -> Result<Vec<f64>, GraphError> {
-    if current.num_elements() == 0 {
-        return Err(GraphError::EmptyMesh { which: "current" });
-    }
-    if expert.num_elements() == 0 {
-        return Err(GraphError::EmptyMesh { which: "expert" });
-    }
     let expert_sizes = expert.sizes();
     let locator = PointLocator::new(current);
     let owners: Vec<usize> =
@@ -169,18 +163,5 @@ mod tests {
         .unwrap();
         let labels = project_expert_sizing(&current, &uneven_expert(), Aggregation::Max).unwrap();
         assert_eq!(labels[2], size(0.3));
-    }
-
-    #[test]
-    fn empty_meshes_are_errors() {
-        let empty = Mesh2::new(vec![], vec![]).unwrap();
-        assert!(matches!(
-            project_expert_sizing(&empty, &square(), Aggregation::Mean),
-            Err(GraphError::EmptyMesh { which: "current" })
-        ));
-        assert!(matches!(
-            project_expert_sizing(&square(), &empty, Aggregation::Mean),
-            Err(GraphError::EmptyMesh { which: "expert" })
-        ));
     }
 }

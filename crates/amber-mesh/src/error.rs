@@ -6,6 +6,9 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum MeshError {
+    /// A mesh needs at least one element.
+    #[error("the mesh has no elements")]
+    Empty,
     /// The flat connectivity length is not a multiple of the nodes per element.
     #[error("connectivity has {len} indices, not a multiple of {nodes_per_element} nodes per element")]
     Connectivity { len: usize, nodes_per_element: usize },

@@ -92,12 +92,9 @@ impl<'m, const D: usize> PointLocator<'m, D> {
         }
     }
 
-    /// The element whose midpoint is nearest to `p`.
-    ///
-    /// # Panics
-    /// Never for a non-empty mesh; an empty mesh has no elements to return.
+    /// The element whose midpoint is nearest to `p` (a [`Mesh`] has at least one element).
     pub fn nearest_midpoint(&self, p: [f64; D]) -> usize {
-        self.midpoints.nearest_neighbor(p).expect("a mesh with at least one element").data as usize
+        self.midpoints.nearest_neighbor(p).expect("Mesh::new refuses meshes without elements").data as usize
     }
 
     /// The smallest barycentric coordinate of `p` in element `e` (≥ 0 inside).

@@ -37,6 +37,9 @@ impl<const D: usize> Mesh<D> {
     fn build(vertices: Vec<[f64; D]>, mut cells: Vec<u32>, reorient: bool) -> Result<Self, MeshError> {
         const { assert!(D == 2 || D == 3, "meshes are 2D or 3D") };
         let n = D + 1;
+        if cells.is_empty() {
+            return Err(MeshError::Empty);
+        }
         if !cells.len().is_multiple_of(n) {
             return Err(MeshError::Connectivity { len: cells.len(), nodes_per_element: n });
         }
@@ -277,6 +280,9 @@ mod tests {
         assert!(matches!(Mesh2::new(v.clone(), vec![0, 1]), Err(MeshError::Connectivity { .. })));
         assert!(matches!(Mesh2::new(v.clone(), vec![0, 1, 7]), Err(MeshError::VertexOutOfRange { vertex: 7, .. })));
         assert!(matches!(Mesh2::new(v, vec![0, 1, 1]), Err(MeshError::NonPositiveElement { .. })));
-        assert!(matches!(Mesh2::new(vec![[f64::NAN, 0.0]], vec![]), Err(MeshError::NonFiniteVertex { vertex: 0 })));
+        let nan = vec![[f64::NAN, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        assert!(matches!(Mesh2::new(nan, vec![0, 1, 2]), Err(MeshError::NonFiniteVertex { vertex: 0 })));
+        assert!(matches!(Mesh2::new(vec![[0.0, 0.0]], vec![]), Err(MeshError::Empty)));
+        assert!(matches!(Mesh3::new(Vec::new(), Vec::new()), Err(MeshError::Empty)));
     }
 }

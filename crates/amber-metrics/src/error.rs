@@ -11,9 +11,6 @@ pub enum MetricsError {
     /// A point has a NaN or infinite coordinate.
     #[error("point {index} of the {which} point set has a non-finite coordinate")]
     NonFinitePoint { which: &'static str, index: usize },
-    /// A mesh has no elements.
-    #[error("the {which} mesh has no elements")]
-    EmptyMesh { which: &'static str },
     /// The k-d tree could not index the points (more than `u32::MAX` of them).
     #[error("cannot index the {which} point set: {source}")]
     KdTree { which: &'static str, source: kiddo::kd_tree::ConstructionError },

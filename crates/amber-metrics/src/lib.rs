@@ -11,7 +11,6 @@ mod dcd;
 mod error;
 mod volume;
 
-pub(crate) use compare::check_mesh;
 pub use compare::{MeshComparison, compare_meshes, midpoint_distance};
 pub use dcd::{PointSetDistance, normalised_dcd, point_set_distance};
 pub use error::MetricsError;
