@@ -83,6 +83,8 @@ impl PolygonDomain {
     }
 
     fn validate(&self) -> Result<(), MeshgenError> {
+        // Squared lengths of edges between such points stay finite.
+        const MAX_COORDINATE: f64 = 1e150;
         let invalid = |msg: String| Err(MeshgenError::InvalidDomain(msg));
         for (r, ring) in self.rings().enumerate() {
             if ring.len() < 3 {
@@ -90,6 +92,11 @@ impl PolygonDomain {
             }
             if let Some(i) = ring.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
                 return invalid(format!("ring {r}, vertex {i} has a non-finite coordinate"));
+            }
+            if let Some(i) = ring.iter().position(|p| p[0].abs().max(p[1].abs()) > MAX_COORDINATE) {
+                return invalid(format!(
+                    "ring {r}, vertex {i} lies beyond ±{MAX_COORDINATE:e}, where edge lengths and areas overflow"
+                ));
             }
             for i in 0..ring.len() {
                 if ring[i] == ring[(i + 1) % ring.len()] {
@@ -106,6 +113,14 @@ impl PolygonDomain {
         for (h, hole) in self.holes.iter().enumerate() {
             if !ring_contains(&self.outer, hole[0]) {
                 return invalid(format!("hole {h} lies outside the outer ring"));
+            }
+            // Rings do not cross, so one vertex tells whether a hole lies inside another.
+            if let Some(outer) =
+                self.holes.iter().position(|other| !std::ptr::eq(other, hole) && ring_contains(other, hole[0]))
+            {
+                return invalid(format!(
+                    "hole {h} lies inside hole {outer} (an island: mesh it as a domain of its own)"
+                ));
             }
         }
         Ok(())
@@ -231,6 +246,15 @@ mod tests {
         assert!(matches!(PolygonDomain::new(repeated, vec![]), Err(MeshgenError::InvalidDomain(_))));
         let nan = vec![[0.0, 0.0], [1.0, f64::NAN], [0.0, 1.0]];
         assert!(matches!(PolygonDomain::new(nan, vec![]), Err(MeshgenError::InvalidDomain(_))));
+        let overflowing = vec![[0.0, 0.0], [1e200, 0.0], [1e200, 1e200], [0.0, 1e200]];
+        assert!(
+            matches!(PolygonDomain::new(overflowing, vec![]), Err(MeshgenError::InvalidDomain(m)) if m.contains("overflow"))
+        );
+        let big = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]].to_vec();
+        let hole = [[1.0, 1.0], [9.0, 1.0], [9.0, 9.0], [1.0, 9.0]].to_vec();
+        let inner = [[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]].to_vec();
+        let nested = PolygonDomain::new(big, vec![hole, inner]);
+        assert!(matches!(nested, Err(MeshgenError::InvalidDomain(m)) if m.contains("inside hole 0")));
         let square = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
         let outside_hole = vec![[2.0, 2.0], [3.0, 2.0], [3.0, 3.0]];
         assert!(PolygonDomain::new(square.clone(), vec![outside_hole]).is_err());

@@ -72,6 +72,12 @@ pub fn generate_2d<F: SizingField<2> + ?Sized>(
         let h = field.size_at(p);
         if h.is_finite() && h > 0.0 { Ok(h) } else { Err(MeshgenError::InvalidSize { at: p.to_vec(), value: h }) }
     };
+    // A field over the cap is refused before any work (once one size is known to be valid);
+    // 2× leaves room for the estimate's error.
+    size(domain.outer()[0])?;
+    if field.estimated_elements(domain.area()).is_some_and(|n| !(n <= 2.0 * params.max_elements as f64)) {
+        return Err(MeshgenError::TooManyElements { cap: params.max_elements });
+    }
     let (points, segments) = discretise_boundary(domain, &size, params.max_elements)?;
     let mut cdt = bulk_load(points, segments)?;
     let side = refine(&mut cdt, &size, params)?;
@@ -90,11 +96,11 @@ pub fn uniform_mesh_2d(domain: &PolygonDomain, size: f64, params: &Mesh2dParams)
     generate_2d(domain, &ConstantSize(size), params)
 }
 
-/// Splits every boundary edge into `ceil(∫ds/h)` pieces of equal ∫ds/h (never longer than the
-/// field asks, as gmsh does). Returns the points and the boundary segments between them.
 /// The boundary's points and the segments between them (indices into the points).
 type BoundarySegments = (Vec<[f64; 2]>, Vec<[usize; 2]>);
 
+/// Splits every boundary edge into `ceil(∫ds/h)` pieces of equal ∫ds/h (never longer than the
+/// field asks, as gmsh does). Returns the points and the boundary segments between them.
 fn discretise_boundary(
     domain: &PolygonDomain,
     size: &impl Fn([f64; 2]) -> Result<f64, MeshgenError>,
@@ -108,7 +114,7 @@ fn discretise_boundary(
         for i in 0..ring.len() {
             let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
             let at = |t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
-            let length = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            let length = (b[0] - a[0]).hypot(b[1] - a[1]);
             // Cumulative ∫ds/h by the midpoint rule, steps of a quarter of the local size.
             samples.clear();
             samples.push((0.0, 0.0));
@@ -118,7 +124,9 @@ fn discretise_boundary(
                 integral += dt * length / size(at(t + 0.5 * dt))?;
                 t += dt;
                 samples.push((t, integral));
-                if integral > max_elements as f64 {
+                // A step too small to advance t (a size far below the edge length) counts as
+                // over the cap too: the loop could not end.
+                if !(integral <= max_elements as f64) || dt <= 0.0 {
                     return Err(MeshgenError::TooManyElements { cap: max_elements });
                 }
             }
@@ -615,11 +623,19 @@ mod tests {
     fn sizes_too_small_for_the_cap_are_refused() {
         let domain = PolygonDomain::lshape([0.5, 0.5]).unwrap();
         let params = Mesh2dParams::default().with_max_elements(10_000);
-        // Boundary alone exceeds the cap.
+        // A field that knows its element count is refused before any work.
         let result = generate_2d(&domain, &ConstantSize(1e-9), &params);
         assert!(matches!(result, Err(MeshgenError::TooManyElements { cap: 10_000 })));
-        // Boundary fits, interior does not.
-        let result = generate_2d(&domain, &ConstantSize(0.003), &params);
+        // One that does not: the boundary alone exceeds the cap.
+        let result = generate_2d(&domain, &FnSize(|_| 1e-9), &params);
+        assert!(matches!(result, Err(MeshgenError::TooManyElements { cap: 10_000 })));
+        // The boundary fits, the interior does not.
+        let result = generate_2d(&domain, &FnSize(|_| 0.003), &params);
+        assert!(matches!(result, Err(MeshgenError::TooManyElements { cap: 10_000 })));
+        // Sizes 200 orders of magnitude below the edges: refused, not looped over.
+        let huge = vec![[0.0, 0.0], [1e140, 0.0], [1e140, 1e140], [0.0, 1e140]];
+        let domain = PolygonDomain::new(huge, vec![]).unwrap();
+        let result = generate_2d(&domain, &FnSize(|_| 1e-60), &params);
         assert!(matches!(result, Err(MeshgenError::TooManyElements { cap: 10_000 })));
     }
 }

@@ -10,6 +10,13 @@ use amber_mesh::{Mesh, PointLocator};
 pub trait SizingField<const D: usize>: Sync {
     /// The target size at `x`.
     fn size_at(&self, x: [f64; D]) -> f64;
+
+    /// ∫ 1/V(h) over a domain of volume `volume`: about the element count a mesh of the field
+    /// has, where the field can tell it without sampling (generators refuse a field over their
+    /// cap before any work). `None`: unknown.
+    fn estimated_elements(&self, _volume: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// The same size everywhere.
@@ -19,6 +26,10 @@ pub struct ConstantSize(pub f64);
 impl<const D: usize> SizingField<D> for ConstantSize {
     fn size_at(&self, _: [f64; D]) -> f64 {
         self.0
+    }
+
+    fn estimated_elements(&self, volume: f64) -> Option<f64> {
+        Some(volume / amber_mesh::volume_from_size::<D>(self.0))
     }
 }
 
@@ -62,6 +73,11 @@ impl<'m, const D: usize> MeshSizing<'m, D> {
 impl<const D: usize> SizingField<D> for MeshSizing<'_, D> {
     fn size_at(&self, x: [f64; D]) -> f64 {
         self.sizes[self.locator.locate_or_nearest(x).element()]
+    }
+
+    /// The estimate over the field's own mesh (which covers the domain being meshed).
+    fn estimated_elements(&self, _volume: f64) -> Option<f64> {
+        Some(estimated_element_count(self.locator.mesh(), &self.sizes))
     }
 }
 

@@ -173,6 +173,10 @@ impl CnnConfig {
         if self.normalise_labels && self.loss == CnnLoss::SoftplusMse {
             return bad("normalise_labels needs loss log_mse or mse");
         }
+        // Upper bounds that a machine can hold, so that a typo is an error, not an abort.
+        if self.resolution > 2_048 || self.initial_channels > 1_024 || self.data.train_problems > 1_000_000 {
+            return bad("resolution at most 2048, initial_channels at most 1024, data.train_problems at most 1000000");
+        }
         Ok(())
     }
 }

@@ -287,6 +287,19 @@ impl TrainingConfig {
         if self.data.train_problems == 0 {
             return bad("data.train_problems must be positive");
         }
+        // Upper bounds that a machine can hold, so that a typo is an error, not an abort.
+        let limits: [(&str, u64, u64); 7] = [
+            ("network.latent_dim", self.network.latent_dim as u64, 4_096),
+            ("network.message_passing_steps", self.network.message_passing_steps as u64, 256),
+            ("batch_nodes", self.batch_nodes as u64, 100_000_000),
+            ("buffer_capacity", self.buffer_capacity as u64, 1_000_000),
+            ("data.train_problems", self.data.train_problems as u64, 1_000_000),
+            ("data.val_problems", self.data.val_problems as u64, 1_000_000),
+            ("inference_steps", self.inference_steps as u64, 10_000),
+        ];
+        if let Some((field, value, max)) = limits.into_iter().find(|&(_, value, max)| value > max) {
+            return Err(TrainError::InvalidConfig(format!("{field} is {value}, at most {max} is supported")));
+        }
         Ok(())
     }
 }
@@ -353,6 +366,12 @@ mod tests {
         assert!(serde_json::from_str::<TrainingConfig>(r#"{"stepz": 10}"#).is_err());
         let bad = TrainingConfig { objective: Objective::Softplus, normalise_labels: true, ..TrainingConfig::quick() };
         assert!(bad.validate().is_err());
+        let huge = TrainingConfig {
+            network: NetworkConfig { latent_dim: 1_000_000_000, ..NetworkConfig::default() },
+            ..TrainingConfig::quick()
+        };
+        let message = huge.validate().unwrap_err().to_string();
+        assert!(message.contains("network.latent_dim") && message.contains("4096"), "{message}");
     }
 
     #[test]
