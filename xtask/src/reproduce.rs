@@ -42,6 +42,10 @@ struct ConsoleArgs {
     /// Retrain and re-evaluate even when cached.
     #[arg(long)]
     force: bool,
+    /// Write under `results/` even from code with uncommitted changes (its results would name
+    /// no commit that made them).
+    #[arg(long)]
+    allow_dirty: bool,
     /// Output directory.
     #[arg(long, default_value = "results/console")]
     out: PathBuf,
@@ -77,6 +81,10 @@ struct PoissonArgs {
     /// Retrain and re-evaluate even when cached.
     #[arg(long)]
     force: bool,
+    /// Write under `results/` even from code with uncommitted changes (its results would name
+    /// no commit that made them).
+    #[arg(long)]
+    allow_dirty: bool,
     /// Output directory.
     #[arg(long, default_value = "results/poisson")]
     out: PathBuf,
@@ -109,6 +117,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn console(args: ConsoleArgs) -> anyhow::Result<()> {
+    check_provenance(&args.out, args.allow_dirty)?;
     let mut experiment = ConsoleExperiment::new(args.profile, &args.data);
     if args.all_train {
         experiment.train_set = TrainSet::All;
@@ -124,6 +133,7 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
 }
 
 fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
+    check_provenance(&args.out, args.allow_dirty)?;
     let mut experiment = PoissonExperiment::new(args.profile);
     if !args.difficulty.is_empty() {
         experiment.difficulties = args.difficulty;
@@ -156,6 +166,10 @@ pub struct AblateArgs {
     /// Retrain and re-evaluate even when cached.
     #[arg(long)]
     force: bool,
+    /// Write under `results/` even from code with uncommitted changes (its results would name
+    /// no commit that made them).
+    #[arg(long)]
+    allow_dirty: bool,
     /// Output directory.
     #[arg(long, default_value = "results/ablate")]
     out: PathBuf,
@@ -163,10 +177,25 @@ pub struct AblateArgs {
 
 /// `cargo xtask ablate`: every ablation of spec §10 as variants of the same training code.
 pub fn ablate(args: AblateArgs) -> anyhow::Result<()> {
+    check_provenance(&args.out, args.allow_dirty)?;
     let mut experiment = PoissonExperiment::ablation(args.profile);
     experiment.force = args.force;
     experiment.out = args.out;
     report(&experiment.run()?, &experiment.out);
+    Ok(())
+}
+
+/// Refuses to write under `results/` (the committed evidence) from a binary built from a dirty
+/// tree, unless `allow_dirty`.
+fn check_provenance(out: &Path, allow_dirty: bool) -> anyhow::Result<()> {
+    if out.starts_with("results") && !allow_dirty && !amber_experiments::built_from_a_clean_commit() {
+        anyhow::bail!(
+            "{}: this binary was built from {}, not a clean commit; commit first, write elsewhere (--out) or pass \
+             --allow-dirty",
+            out.display(),
+            amber_experiments::commit()
+        );
+    }
     Ok(())
 }
 

@@ -16,7 +16,6 @@ use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::profiles::{Task, amber_config, cnn_config};
-use crate::report::{commit, machine};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 
@@ -145,14 +144,8 @@ impl ConsoleExperiment {
                 }
             }
         }
-        let results = ExperimentResults {
-            experiment: "console".into(),
-            profile: self.profile.name().into(),
-            commit: commit(),
-            machine: machine(),
-            config: serde_json::json!({ "experiment": self, "test_split": test_split.name(), "runs": configs }),
-            runs,
-        };
+        let config = serde_json::json!({ "experiment": self, "test_split": test_split.name(), "runs": configs });
+        let results = ExperimentResults::new("console", self.profile.name(), config, runs);
         let setting = Setting { name: "console".into(), caption: format!("Console ({} parts)", test_split.name()) };
         write_outputs(&self.out, &results, &[setting], &self.methods, &paper_number)?;
         let experts: Vec<&Mesh3> = test.iter().take(GALLERY_PROBLEMS).map(|p| &p.expert_mesh).collect();

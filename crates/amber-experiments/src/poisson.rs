@@ -17,7 +17,7 @@ use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::profiles::{Task, amber_config, cnn_config};
 use crate::progress::item_bar;
-use crate::report::{commit, machine, merge_json, read_json};
+use crate::report::{merge_json, read_json};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 
@@ -224,14 +224,8 @@ impl PoissonExperiment {
             }
             galleries.push((difficulty, test, rows));
         }
-        let results = ExperimentResults {
-            experiment: self.experiment.clone(),
-            profile: self.profile.name().into(),
-            commit: commit(),
-            machine: machine(),
-            config: serde_json::json!({ "experiment": self, "runs": configs }),
-            runs,
-        };
+        let config = serde_json::json!({ "experiment": self, "runs": configs });
+        let results = ExperimentResults::new(&self.experiment, self.profile.name(), config, runs);
         let settings: Vec<Setting> = self
             .difficulties
             .iter()

@@ -48,20 +48,17 @@ pub fn machine() -> serde_json::Value {
     })
 }
 
-/// The commit the running code was built from (`git rev-parse HEAD`, with `-dirty` when the
-/// tree has changes), or `None` outside a git checkout.
-pub fn commit() -> Option<String> {
-    let git = |args: &[&str]| {
-        std::process::Command::new("git")
-            .args(args)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
-    let head = git(&["rev-parse", "HEAD"])?;
-    let dirty = git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
-    Some(if dirty { format!("{head}-dirty") } else { head })
+/// The commit the running code was built from: its hash, with `-dirty` when tracked files outside
+/// `results/` had local changes at build time (`unknown` outside a git checkout). Embedded at
+/// build time, so it names the binary's code wherever it runs.
+pub fn commit() -> &'static str {
+    env!("AMBER_COMMIT")
+}
+
+/// Whether [`commit`] names a clean commit, the only code whose numbers may go to `results/`.
+pub fn built_from_a_clean_commit() -> bool {
+    let commit = commit();
+    commit != "unknown" && !commit.ends_with("-dirty")
 }
 
 /// Short hex SHA-256 of a JSON value's canonical text (object keys are sorted by serde_json's

@@ -79,6 +79,8 @@ pub struct RunResult {
     pub failed_steps: usize,
     pub train_seconds: f64,
     pub eval_seconds: f64,
+    /// Every test problem's rollout: the values the means above reduce.
+    pub problems: Vec<ProblemEvaluation>,
 }
 
 /// Where a run result came from, apart from its evaluations.
@@ -121,6 +123,7 @@ impl RunResult {
                 .count(),
             train_seconds: key.train_seconds,
             eval_seconds: key.eval_seconds,
+            problems: problems.to_vec(),
         }
     }
 }
@@ -137,14 +140,22 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
     }
 }
 
+/// Version of the `results.json` schema: 2 added the per-problem values, the schema and amber
+/// versions, and a commit that is always named.
+pub const RESULTS_SCHEMA: u32 = 2;
+
 /// `results.json`: one experiment.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ExperimentResults {
+    /// Version of this schema ([`RESULTS_SCHEMA`]).
+    pub schema: u32,
+    /// The amber release that wrote the file.
+    pub amber_version: String,
     /// `poisson`, `console` or `ablate`.
     pub experiment: String,
     pub profile: String,
-    /// The commit the code was built from (`-dirty` with local changes).
-    pub commit: Option<String>,
+    /// The commit the code was built from (`-dirty` with local changes; see [`crate::commit`]).
+    pub commit: String,
     /// CPU, cores, memory, load.
     pub machine: serde_json::Value,
     /// Everything needed to rerun: the experiment's settings and each run's training config.
@@ -153,6 +164,20 @@ pub struct ExperimentResults {
 }
 
 impl ExperimentResults {
+    /// The results of `runs`, stamped with this build's commit, version and machine.
+    pub fn new(experiment: &str, profile: &str, config: serde_json::Value, runs: Vec<RunResult>) -> Self {
+        Self {
+            schema: RESULTS_SCHEMA,
+            amber_version: env!("CARGO_PKG_VERSION").into(),
+            experiment: experiment.into(),
+            profile: profile.into(),
+            commit: crate::commit().into(),
+            machine: crate::machine(),
+            config,
+            runs,
+        }
+    }
+
     /// The problems the runs were evaluated on, for captions: the test problems, or the split a
     /// task without a test split fell back to (`config.test_split`).
     pub fn evaluated_on(&self) -> String {
@@ -209,9 +234,11 @@ mod tests {
     #[test]
     fn captions_name_the_split_that_was_evaluated() {
         let results = |config| ExperimentResults {
+            schema: RESULTS_SCHEMA,
+            amber_version: "0.1.0".into(),
             experiment: "console".into(),
             profile: "quick".into(),
-            commit: None,
+            commit: "0123abc".into(),
             machine: serde_json::json!({}),
             config,
             runs: Vec::new(),

@@ -132,7 +132,6 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
             );
         }
     }
-    let _ =
-        writeln!(md, "\nCommit `{}`; machine: {}.", results.commit.as_deref().unwrap_or("unknown"), results.machine);
+    let _ = writeln!(md, "\nCommit `{}`; machine: {}.", results.commit, results.machine);
     md
 }

@@ -75,7 +75,7 @@ pub fn generate_2d<F: SizingField<2> + ?Sized>(
     // A field over the cap is refused before any work (once one size is known to be valid);
     // 2× leaves room for the estimate's error.
     size(domain.outer()[0])?;
-    if field.estimated_elements(domain.area()).is_some_and(|n| !(n <= 2.0 * params.max_elements as f64)) {
+    if field.estimated_elements(domain.area()).is_some_and(|n| !n.is_finite() || n > 2.0 * params.max_elements as f64) {
         return Err(MeshgenError::TooManyElements { cap: params.max_elements });
     }
     let (points, segments) = discretise_boundary(domain, &size, params.max_elements)?;
@@ -126,7 +126,7 @@ fn discretise_boundary(
                 samples.push((t, integral));
                 // A step too small to advance t (a size far below the edge length) counts as
                 // over the cap too: the loop could not end.
-                if !(integral <= max_elements as f64) || dt <= 0.0 {
+                if !integral.is_finite() || integral > max_elements as f64 || dt <= 0.0 {
                     return Err(MeshgenError::TooManyElements { cap: max_elements });
                 }
             }
