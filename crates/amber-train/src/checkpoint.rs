@@ -131,12 +131,39 @@ pub(crate) struct TrainingState {
     pub additions: AdditionCounts,
 }
 
-/// The directory of the newest complete checkpoint under `out_dir`, if any.
+impl TrainingState {
+    /// Checks what the file says against itself and the run's `problems` training problems:
+    /// entry ids unique and below the next id, problem indices in range.
+    pub(crate) fn check(&self, problems: usize) -> std::result::Result<(), String> {
+        let entries = || self.protected.iter().chain(&self.generated);
+        let mut ids = HashSet::new();
+        for e in entries() {
+            if e.id >= self.next_entry_id || !ids.insert(e.id) {
+                return Err(format!("buffer entry id {} is repeated or not below next_entry_id", e.id));
+            }
+            if e.problem >= problems {
+                return Err(format!("buffer entry {} belongs to problem {}, of {problems}", e.id, e.problem));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The directory of the newest complete checkpoint under `out_dir`, if any. `latest` must name
+/// a checkpoint of this run (`step-NNNNNNNN`), never a path elsewhere.
 pub fn latest_checkpoint(out_dir: &Path) -> Result<Option<PathBuf>> {
     let root = out_dir.join(CHECKPOINTS_DIR);
     let latest = root.join(LATEST_FILE);
     match std::fs::read_to_string(&latest) {
-        Ok(name) => Ok(Some(root.join(name.trim()))),
+        Ok(name) => {
+            let name = name.trim();
+            let digits = name.strip_prefix("step-").filter(|d| d.len() == 8 && d.bytes().all(|b| b.is_ascii_digit()));
+            if digits.is_none() {
+                let message = format!("`{name}` is not the name of a checkpoint (step-NNNNNNNN)");
+                return Err(TrainError::Checkpoint { path: latest, message });
+            }
+            Ok(Some(root.join(name)))
+        }
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(e) => Err(io_error(latest)(e)),
     }
@@ -253,4 +280,47 @@ pub(crate) fn load_entry<const D: usize>(
         sampled_count: record.sampled_count,
         sample: Sample { state, labels, targets },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn latest_names_a_checkpoint_of_the_run_and_nothing_else() {
+        let out = std::env::temp_dir().join(format!("amber-latest-{}", std::process::id()));
+        let root = out.join(CHECKPOINTS_DIR);
+        std::fs::create_dir_all(&root).unwrap();
+        assert_eq!(latest_checkpoint(&out).unwrap(), None);
+        for bad in ["../../elsewhere", "/etc", "step-1", "step-0000000x", ""] {
+            std::fs::write(root.join(LATEST_FILE), bad).unwrap();
+            let err = latest_checkpoint(&out).unwrap_err().to_string();
+            assert!(err.contains("not the name of a checkpoint"), "{bad}: {err}");
+        }
+        std::fs::write(root.join(LATEST_FILE), "step-00000250\n").unwrap();
+        assert_eq!(latest_checkpoint(&out).unwrap(), Some(root.join("step-00000250")));
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+
+    #[test]
+    fn a_state_with_colliding_or_foreign_entries_is_refused() {
+        let entry = |id, problem| EntryRecord { id, problem, depth: 0, sampled_count: 0 };
+        let rng = RngState::of(&seeded_stream(0, 1));
+        let state = |next_entry_id, protected: Vec<EntryRecord>| TrainingState {
+            config: TrainingConfig::smoke(),
+            step: 0,
+            optimiser_steps: 0,
+            dropout_rng: rng.clone(),
+            buffer_rng: rng.clone(),
+            problems: Vec::new(),
+            next_entry_id,
+            protected,
+            generated: vec![entry(1, 0)],
+            additions: AdditionCounts::default(),
+        };
+        assert!(state(2, vec![entry(0, 1)]).check(2).is_ok());
+        assert!(state(0, vec![entry(0, 1)]).check(2).unwrap_err().contains("next_entry_id"), "wrapped id");
+        assert!(state(2, vec![entry(1, 1)]).check(2).is_err(), "repeated id");
+        assert!(state(2, vec![entry(0, 5)]).check(2).unwrap_err().contains("problem 5"));
+    }
 }

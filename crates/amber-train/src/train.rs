@@ -180,6 +180,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         if state.problems != fingerprints(&problems) {
             return Err(fail("the training problems differ from the checkpointed run's".into()));
         }
+        state.check(problems.len()).map_err(fail)?;
         let predictor: Predictor = read_json(&dir.join(crate::model::PREDICTOR_FILE))?;
         let (network, varmap) = Mpn::load_trainable(&dir.join(WEIGHTS_FILE), DType::F32, &Device::Cpu)?;
         let mut optimiser = Adam::new(&varmap, config.max_grad_norm)?;
