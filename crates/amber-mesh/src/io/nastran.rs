@@ -1,6 +1,7 @@
 //! NASTRAN bulk data (`.nas`) → tetrahedral mesh: GRID points and 4-node CTETRA elements, in
 //! small fixed-field (8 characters) or free-field (comma-separated) form. Surface elements
-//! (CTRIA3) and every other card are skipped; reading stops at ENDDATA. Reals may use NASTRAN's
+//! (CTRIA3) and every other card are skipped; reading stops at ENDDATA, which must be there: a
+//! file without it is truncated, and a partial mesh is never returned. Reals may use NASTRAN's
 //! implicit exponent (`-7.11-15` = -7.11e-15). GRID ids may have gaps.
 
 use std::collections::HashMap;
@@ -18,6 +19,7 @@ pub(super) fn read<const D: usize>(path: &Path, bytes: &[u8]) -> Result<(Mesh<D>
     let mut vertices: Vec<[f64; D]> = Vec::new();
     // CTETRA grid ids with their line, resolved once every GRID is known (cards may come in any order).
     let mut tets: Vec<([u64; 4], usize)> = Vec::new();
+    let mut complete = false;
     while let Some(line) = lines.next()? {
         if line.starts_with('$') || line.trim().is_empty() {
             continue;
@@ -53,7 +55,10 @@ pub(super) fn read<const D: usize>(path: &Path, bytes: &[u8]) -> Result<(Mesh<D>
                 }
                 tets.push((ids, lines.line));
             }
-            "ENDDATA" => break,
+            "ENDDATA" => {
+                complete = true;
+                break;
+            }
             _ => {}
         }
     }
@@ -70,6 +75,10 @@ pub(super) fn read<const D: usize>(path: &Path, bytes: &[u8]) -> Result<(Mesh<D>
             })?;
             cells.push(*v);
         }
+    }
+    if !complete {
+        let message = format!("no ENDDATA after line {}: the file is truncated", lines.line);
+        return Err(MeshError::Format { path: path.to_owned(), message });
     }
     assemble(path, vertices, cells, MeshData::new())
 }
@@ -195,6 +204,9 @@ GRID          99            junk\r\n";
             assert!(message.starts_with(&format!("inline.nas:{line}:")) && message.contains(needle), "{message}");
         }
         assert!(parse("GRID 1 0. 0. 0.\n").unwrap_err().to_string().contains("no CTETRA"));
+        let truncated = &TWO_TETS[..TWO_TETS.find("CTETRA         2").unwrap()];
+        let message = parse(truncated).unwrap_err().to_string();
+        assert!(message.contains("no ENDDATA after line 9") && message.contains("truncated"), "{message}");
         let degenerate = TWO_TETS.replace("0.25    0.25     -1.", "  0.      0.      0.");
         assert!(matches!(parse(&degenerate), Err(MeshError::InvalidMesh { .. })));
         assert!(matches!(
