@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use amber_mesh::Mesh2;
+use amber_stdx::read_json;
 use amber_tasks::poisson::{Difficulty, PoissonProblem, Split, load_split, read_split};
 use amber_train::{CnnConfig, Profile, TrainingConfig};
 use anyhow::bail;
@@ -14,7 +15,7 @@ use crate::method::{Method, MethodSpec, Variant};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::progress::item_bar;
-use crate::report::{commit, machine, merge_json, read_json};
+use crate::report::{commit, machine, merge_json};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 
