@@ -6,10 +6,9 @@
 use amber_fem::{ExpertHeuristic, FemError, P1Space, Quadrature, element_stats};
 use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, NodeFeature, project_expert_sizing};
 use amber_mesh::Mesh;
-use amber_meshgen::{
-    Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, estimated_element_count, generate_2d, quantile,
-};
+use amber_meshgen::{Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, estimated_element_count, generate_2d};
 use amber_metrics::MetricsError;
+use amber_stdx::quantile;
 use amber_tasks::poisson::PoissonProblem;
 use serde::{Deserialize, Serialize};
 
