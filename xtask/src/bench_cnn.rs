@@ -9,6 +9,7 @@ use std::time::Instant;
 
 use amber_cnn::{CnnLoss, UNet, UNetConfig};
 use amber_mpn::{TrainConfig, Trainer};
+use amber_stdx::median;
 use anyhow::{Context, bail};
 use candle_core::{DType, Device, Tensor};
 use rand::rngs::StdRng;
@@ -185,12 +186,6 @@ fn time(args: &Args, step: &mut dyn FnMut() -> anyhow::Result<()>) -> anyhow::Re
             Ok(t.elapsed().as_secs_f64())
         })
         .collect()
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s.get(s.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// `/proc/loadavg`: how busy the shared machine was around a measurement.

@@ -9,7 +9,6 @@
 //! L-shape at 0.19 s and triplet assembly at 0.17 s on this kind of machine.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use amber_fem::{ExpertHeuristic, P1Space, Quadrature};
 use amber_mesh::Mesh2;
@@ -18,6 +17,7 @@ use amber_tasks::poisson::{Difficulty, INITIAL_SIZE, ProblemSample, initial_mesh
 use serde::Serialize;
 
 use crate::report::write_json;
+use crate::timing::{CpuClock, median_time};
 
 #[derive(clap::Args, Debug, Serialize)]
 pub struct Args {
@@ -70,8 +70,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let parallel = rayon::ThreadPoolBuilder::new().num_threads(args.threads).build()?;
 
-    let (expert, seconds, cpu_seconds) =
-        median_time(args.repeats, || one.install(|| ExpertHeuristic::default().run(&m0, &sample.load, steps)))?;
+    let (expert, seconds, cpu_seconds) = median_time(args.repeats, CpuClock::Process, || {
+        one.install(|| ExpertHeuristic::default().run(&m0, &sample.load, steps))
+    })?;
     let expert_case = ExpertCase {
         seed,
         steps,
@@ -102,9 +103,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             Ok((space.stiffness(), rhs))
         };
         let ((stiffness, rhs), assemble_seconds, _) =
-            median_time(args.repeats, || parallel.install(|| assemble(&mesh)))?;
-        let (_, single_thread_assemble_seconds, _) = median_time(args.repeats, || one.install(|| assemble(&mesh)))?;
-        let (x, solve_seconds, _) = median_time(args.repeats, || stiffness.solve(&rhs))?;
+            median_time(args.repeats, CpuClock::Process, || parallel.install(|| assemble(&mesh)))?;
+        let (_, single_thread_assemble_seconds, _) =
+            median_time(args.repeats, CpuClock::Process, || one.install(|| assemble(&mesh)))?;
+        let (x, solve_seconds, _) = median_time(args.repeats, CpuClock::Process, || stiffness.solve(&rhs))?;
         let case = SolveCase {
             triangles: mesh.num_elements(),
             dofs: stiffness.dofs(),
@@ -148,31 +150,4 @@ fn grid(n: usize) -> anyhow::Result<Mesh2> {
         .flat_map(|(i, j)| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)])
         .collect();
     Ok(Mesh2::new(vertices, cells)?)
-}
-
-/// Runs `make` `repeats` times; returns its last result and the median wall and process-CPU times.
-fn median_time<T, E: Into<anyhow::Error>>(
-    repeats: usize,
-    mut make: impl FnMut() -> Result<T, E>,
-) -> anyhow::Result<(T, f64, f64)> {
-    let (mut wall, mut cpu, mut last) = (Vec::new(), Vec::new(), None);
-    for _ in 0..repeats.max(1) {
-        let (start, cpu_start) = (Instant::now(), process_cpu_seconds());
-        last = Some(make().map_err(Into::into)?);
-        wall.push(start.elapsed().as_secs_f64());
-        cpu.push(process_cpu_seconds() - cpu_start);
-    }
-    wall.sort_by(f64::total_cmp);
-    cpu.sort_by(f64::total_cmp);
-    Ok((last.expect("at least one repetition"), wall[wall.len() / 2], cpu[cpu.len() / 2]))
-}
-
-/// User + system CPU time of the whole process, from /proc (clock ticks of 10 ms): the timed
-/// work runs on rayon's threads, not the caller's.
-fn process_cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let rest = stat.rsplit_once(')').map(|(_, r)| r).unwrap_or("");
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok()).unwrap_or(0.0);
-    (ticks(11) + ticks(12)) / 100.0
 }

@@ -3,7 +3,6 @@
 //! the same element counts as an in-run reference.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use amber_mesh::Mesh2;
 use amber_meshgen::{ConstantSize, FnSize, Mesh2dParams, PolygonDomain, QualityReport, generate_2d};
@@ -11,6 +10,7 @@ use serde::Serialize;
 use spade::{AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
 
 use crate::report::write_json;
+use crate::timing::{CpuClock, median_time};
 
 #[derive(clap::Args, Debug, Serialize)]
 pub struct Args {
@@ -35,8 +35,8 @@ struct Case {
     /// Median wall time.
     seconds: f64,
     triangles_per_second: f64,
-    /// CPU time of the meshing thread in the same run (10 ms resolution): the wall time
-    /// without the share lost to other processes on a busy machine.
+    /// Median CPU time of the meshing thread: the wall time without the share lost to other
+    /// processes on a busy machine.
     cpu_seconds: f64,
     triangles_per_cpu_second: f64,
     quality: QualityReport,
@@ -48,14 +48,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for (name, scale) in [("graded-10k", 0.21), ("graded-100k", 0.0666), ("graded-1M", 0.021)] {
         let field = FnSize(graded_field(scale));
         let (mesh, seconds, cpu) =
-            median_time(args.repeats, || generate_2d(&domain, &field, &Mesh2dParams::default()))?;
+            median_time(args.repeats, CpuClock::Thread, || generate_2d(&domain, &field, &Mesh2dParams::default()))?;
         cases.push(case(name, &mesh, seconds, cpu, QualityReport::measure(&mesh, &field)));
     }
     for (name, triangles) in
         [("spade-refine-uniform-10k", 1e4), ("spade-refine-uniform-100k", 1e5), ("spade-refine-uniform-1M", 1e6)]
     {
         let max_area = 1.5 * domain.area() / triangles;
-        let (mesh, seconds, cpu) = median_time(args.repeats, || spade_uniform(&domain, max_area))?;
+        let (mesh, seconds, cpu) = median_time(args.repeats, CpuClock::Thread, || spade_uniform(&domain, max_area))?;
         // Sizes measured against the regular triangle of half the area cap (refine's typical area).
         let target = amber_mesh::size_from_volume::<2>(0.5 * max_area);
         cases.push(case(name, &mesh, seconds, cpu, QualityReport::measure(&mesh, &ConstantSize(target))));
@@ -92,35 +92,6 @@ fn case(name: &str, mesh: &Mesh2, seconds: f64, cpu_seconds: f64, quality: Quali
         triangles_per_cpu_second: triangles as f64 / cpu_seconds,
         quality,
     }
-}
-
-/// Runs `make` `repeats` times; returns its last result and the median wall and thread-CPU times.
-fn median_time<T, E: Into<anyhow::Error>>(
-    repeats: usize,
-    mut make: impl FnMut() -> Result<T, E>,
-) -> anyhow::Result<(T, f64, f64)> {
-    let mut wall = Vec::new();
-    let mut cpu = Vec::new();
-    let mut last = None;
-    for _ in 0..repeats.max(1) {
-        let (start, cpu_start) = (Instant::now(), thread_cpu_seconds());
-        last = Some(make().map_err(Into::into)?);
-        wall.push(start.elapsed().as_secs_f64());
-        cpu.push(thread_cpu_seconds() - cpu_start);
-    }
-    wall.sort_by(f64::total_cmp);
-    cpu.sort_by(f64::total_cmp);
-    Ok((last.expect("at least one repetition"), wall[wall.len() / 2], cpu[cpu.len() / 2].max(0.01)))
-}
-
-/// User + system CPU time of the calling thread, from /proc (clock ticks of 10 ms).
-fn thread_cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").unwrap_or_default();
-    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
-    let rest = stat.rsplit_once(')').map(|(_, r)| r).unwrap_or("");
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok()).unwrap_or(0.0);
-    (ticks(11) + ticks(12)) / 100.0
 }
 
 /// spade's built-in refinement: a uniform area bound, 20° angle limit, notch excluded.

@@ -8,11 +8,13 @@ use std::time::Instant;
 
 use amber_mesh::{Mesh3, read_mesh};
 use amber_meshgen::mesh3d::{Mesh3dParams, StlFaceIds, Surface, adapt_surface, fill_surface};
-use amber_meshgen::{MeshSizing, SizingField, quantile};
+use amber_meshgen::{MeshSizing, SizingField};
+use amber_stdx::{median, quantile};
 use anyhow::Context;
 use serde::Serialize;
 
 use crate::report::write_json;
+use crate::timing::{CpuClock, CpuTimer};
 
 #[derive(clap::Args, Debug, Serialize)]
 pub struct Args {
@@ -97,21 +99,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         parts.push(part);
     }
     anyhow::ensure!(!parts.is_empty(), "{}: no parts matched", args.data.display());
-    let median = |f: &dyn Fn(&Part) -> f64| {
-        let mut v: Vec<f64> = parts.iter().map(f).collect();
-        v.sort_by(f64::total_cmp);
-        quantile(&v, 0.5)
-    };
+    let median_of = |f: &dyn Fn(&Part) -> f64| median(&parts.iter().map(f).collect::<Vec<_>>());
     let medians = Medians {
-        tets_over_expert: median(&|p| p.tets_over_expert),
-        size_ratio_median: median(&|p| p.size_ratio_median),
-        min_dihedral_deg: median(&|p| p.min_dihedral_deg),
-        abs_volume_error: median(&|p| p.volume_error.abs()),
-        seconds_surface: median(&|p| p.seconds_surface),
-        seconds_volume: median(&|p| p.seconds_volume),
-        seconds_total: median(&|p| p.seconds_total),
+        tets_over_expert: median_of(&|p| p.tets_over_expert),
+        size_ratio_median: median_of(&|p| p.size_ratio_median),
+        min_dihedral_deg: median_of(&|p| p.min_dihedral_deg),
+        abs_volume_error: median_of(&|p| p.volume_error.abs()),
+        seconds_surface: median_of(&|p| p.seconds_surface),
+        seconds_volume: median_of(&|p| p.seconds_volume),
+        seconds_total: median_of(&|p| p.seconds_total),
         seconds_total_max: parts.iter().map(|p| p.seconds_total).fold(0.0, f64::max),
-        cpu_seconds_total: median(&|p| p.cpu_seconds_total),
+        cpu_seconds_total: median_of(&|p| p.cpu_seconds_total),
     };
     let acceptance = serde_json::json!({
         "tets_within_0.8_1.3": parts.iter().filter(|p| (0.8..=1.3).contains(&p.tets_over_expert)).count(),
@@ -175,12 +173,12 @@ fn bench_part(data: &Path, name: &str, params: &Mesh3dParams) -> anyhow::Result<
     let surface_path = data.join("reference_surface").join(format!("{name}.stl"));
     let (reference, report) = Surface::load(&surface_path, StlFaceIds::FromFile)?;
     let field = MeshSizing::from_element_sizes(&expert);
-    let (start, cpu_start) = (Instant::now(), thread_cpu_seconds());
+    let (start, cpu) = (Instant::now(), CpuTimer::start(CpuClock::Thread));
     let surface = adapt_surface(&reference, &field, params).with_context(|| format!("{name}: surface"))?;
     let seconds_surface = start.elapsed().as_secs_f64();
     let mesh = fill_surface(&surface, &field, params).with_context(|| format!("{name}: volume"))?;
     let seconds_total = start.elapsed().as_secs_f64();
-    let cpu_seconds_total = thread_cpu_seconds() - cpu_start;
+    let cpu_seconds_total = cpu.seconds();
     let mut ratios: Vec<f64> =
         (0..mesh.num_elements()).map(|e| mesh.size(e) / field.size_at(mesh.midpoint(e))).collect();
     ratios.sort_by(f64::total_cmp);
@@ -202,10 +200,4 @@ fn bench_part(data: &Path, name: &str, params: &Mesh3dParams) -> anyhow::Result<
         seconds_total,
         cpu_seconds_total,
     })
-}
-
-/// Time the calling thread has run on a CPU, from the scheduler's statistics (nanoseconds).
-fn thread_cpu_seconds() -> f64 {
-    let stats = std::fs::read_to_string("/proc/thread-self/schedstat").unwrap_or_default();
-    stats.split_whitespace().next().and_then(|ns| ns.parse::<f64>().ok()).map_or(0.0, |ns| ns * 1e-9)
 }

@@ -14,9 +14,12 @@ use std::time::Instant;
 use amber_graph::{Aggregation, project_expert_sizing};
 use amber_mesh::Mesh2;
 use amber_metrics::point_set_distance;
+use amber_stdx::median;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use serde::Serialize;
+
+use crate::timing::{CpuClock, cpu_seconds};
 
 #[derive(clap::Args, Debug, Serialize)]
 pub struct Args {
@@ -129,8 +132,8 @@ fn time_case(
             times.push(start.elapsed().as_secs_f64());
         }
         let cpu_s = cpu_start.zip(pool_cpu_seconds(&pool)).map(|(a, b)| (b - a) / args.repeats as f64);
-        times.sort_by(f64::total_cmp);
-        Ok(Timing { median_s: times[times.len() / 2], min_s: times[0], cpu_s, checksum })
+        let min_s = times.iter().copied().fold(f64::INFINITY, f64::min);
+        Ok(Timing { median_s: median(&times), min_s, cpu_s, checksum })
     };
     let Timing { median_s, min_s, cpu_s, checksum } = median_on(args.threads)?;
     let single_thread_median_s = median_on(1)?.median_s;
@@ -156,12 +159,7 @@ struct Timing {
 
 /// CPU time consumed so far by the threads of `pool`, from Linux's per-thread `schedstat` (ns).
 fn pool_cpu_seconds(pool: &rayon::ThreadPool) -> Option<f64> {
-    pool.broadcast(|_| {
-        let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-        Some(stat.split_whitespace().next()?.parse::<u64>().ok()? as f64 * 1e-9)
-    })
-    .into_iter()
-    .sum()
+    pool.broadcast(|_| cpu_seconds(CpuClock::Thread)).into_iter().sum()
 }
 
 /// The unit square as `n × n` squares, each split into two triangles along its rising diagonal.

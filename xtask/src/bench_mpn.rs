@@ -8,11 +8,14 @@ use std::time::Instant;
 
 use amber_mpn::synthetic::random_graph;
 use amber_mpn::{GraphInput, Mpn, MpnConfig, TrainConfig, Trainer, mse};
+use amber_stdx::median;
 use anyhow::{Context, bail};
 use candle_core::{DType, Device, Tensor};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use serde_json::{Value, json};
+
+use crate::timing::{CLOCK_TICKS_PER_S, CpuClock, CpuTimer};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -88,7 +91,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "candle_threads": candle_core::utils::get_num_threads(),
         "iters": args.iters,
         "warmup": args.warmup,
-        "machine": machine(),
+        "machine": crate::report::machine(),
         "cases": cases,
         "ratios": ratios(&cases, peer.as_ref()),
         "peer": peer,
@@ -172,16 +175,6 @@ fn bench_case(
     }))
 }
 
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    match s.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => s[n / 2],
-        n => 0.5 * (s[n / 2 - 1] + s[n / 2]),
-    }
-}
-
 /// Resets the kernel's peak-RSS counter of this process (Linux `clear_refs` 5).
 fn reset_peak_rss() -> bool {
     std::fs::write("/proc/self/clear_refs", "5").is_ok()
@@ -194,52 +187,40 @@ fn peak_rss_gib() -> Option<f64> {
 }
 
 /// CPUs used by other processes while a case runs: the machine's busy time from `/proc/stat`
-/// minus this process's own from `/proc/self/stat`, as in the peer benchmarks.
-const CLOCK_TICKS_PER_S: f64 = 100.0;
-
+/// minus this process's own CPU time, as in the peer benchmarks.
 struct CpuLoad {
     busy: u64,
     total: u64,
-    own: u64,
+    own: CpuTimer,
 }
 
 impl CpuLoad {
-    fn read() -> Option<(u64, u64, u64)> {
+    /// The machine's busy and total clock ticks so far.
+    fn machine_ticks() -> Option<(u64, u64)> {
         let stat = std::fs::read_to_string("/proc/stat").ok()?;
         let v: Vec<u64> = stat.lines().next()?.split_whitespace().skip(1).filter_map(|x| x.parse().ok()).collect();
         let total: u64 = v.iter().sum();
-        let busy = total - v.get(3)? - v.get(4)?;
-        let own_stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-        let fields: Vec<&str> = own_stat.rsplit_once(')')?.1.split_whitespace().collect();
-        let own = fields.get(11)?.parse::<u64>().ok()? + fields.get(12)?.parse::<u64>().ok()?;
-        Some((busy, total, own))
+        Some((total - v.get(3)? - v.get(4)?, total))
     }
 
     fn start() -> Self {
-        let (busy, total, own) = Self::read().unwrap_or_default();
-        Self { busy, total, own }
+        let (busy, total) = Self::machine_ticks().unwrap_or_default();
+        Self { busy, total, own: CpuTimer::start(CpuClock::Process) }
     }
 
     /// CPU seconds (user + system, all threads) this process used since `start`.
     fn own_cpu_s(&self) -> f64 {
-        Self::read().map_or(f64::NAN, |(_, _, own)| (own - self.own) as f64 / CLOCK_TICKS_PER_S)
+        self.own.seconds()
     }
 
     fn other_cpus(&self) -> f64 {
-        let Some((busy, total, own)) = Self::read() else {
+        let Some((busy, total)) = Self::machine_ticks() else {
             return f64::NAN;
         };
         let cpus = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
-        let other = (busy - self.busy) as f64 - (own - self.own) as f64;
-        (other / (total - self.total).max(1) as f64 * cpus).max(0.0)
+        let other = (busy - self.busy) as f64 / CLOCK_TICKS_PER_S - self.own.seconds();
+        (other / ((total - self.total).max(1) as f64 / CLOCK_TICKS_PER_S) * cpus).max(0.0)
     }
-}
-
-fn machine() -> Value {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo").ok().and_then(|s| {
-        s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_owned())
-    });
-    json!({ "cpu_model": cpu, "cpus": std::thread::available_parallelism().map_or(1, |n| n.get()) })
 }
 
 /// Runs the PyTorch peer (plain and PyG aggregation) on a graph of the same size, with self-loops,

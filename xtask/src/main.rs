@@ -14,6 +14,7 @@ mod label_rollouts;
 mod reference_distances;
 mod report;
 mod reproduce;
+mod timing;
 
 use clap::{Parser, Subcommand};
 

@@ -4,7 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use amber_experiments::{ConsoleExperiment, ExperimentResults, Method, MethodSpec, PoissonExperiment, read_json};
+use amber_experiments::{ConsoleExperiment, ExperimentResults, Method, MethodSpec, PoissonExperiment};
+use amber_stdx::read_json;
 use amber_tasks::console::TrainSet;
 use amber_tasks::poisson::Difficulty;
 use amber_train::Profile;

@@ -30,5 +30,14 @@ pub enum CnnError {
     Candle(#[from] candle_core::Error),
 }
 
+impl From<amber_stdx::FileError> for CnnError {
+    fn from(e: amber_stdx::FileError) -> Self {
+        match e {
+            amber_stdx::FileError::Io { path, source } => CnnError::Io { path, source },
+            amber_stdx::FileError::Json { path, source } => CnnError::Json { path, source },
+        }
+    }
+}
+
 /// `Result` with [`CnnError`].
 pub type Result<T, E = CnnError> = std::result::Result<T, E>;

@@ -249,12 +249,11 @@ impl UNet {
     }
 
     /// Writes every parameter and running statistic to `weights` (safetensors, atomically: a
-    /// temporary file, then a rename).
+    /// temporary file, fsynced, then a rename).
     pub fn save(&self, weights: &Path) -> Result<()> {
-        let name = weights.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let tmp = weights.with_file_name(format!(".{name}.tmp"));
-        self.varmap.save(&tmp).map_err(|e| CnnError::ModelFile { path: tmp.clone(), message: e.to_string() })?;
-        std::fs::rename(&tmp, weights).map_err(|source| CnnError::Io { path: weights.into(), source })
+        amber_stdx::write_atomic_via(weights, |tmp| {
+            self.varmap.save(tmp).map_err(|e| CnnError::ModelFile { path: tmp.into(), message: e.to_string() })
+        })
     }
 
     pub fn config(&self) -> &UNetConfig {

@@ -24,9 +24,7 @@ pub use plots::{Bar, Series, Tile, TileMesh, bar_chart, line_chart, mesh_gallery
 pub use poisson::{PoissonExperiment, train_poisson};
 pub use profiles::{Task, amber_config, cnn_config};
 pub use progress::{TrainingProgress, item_bar};
-pub use report::{
-    built_from_a_clean_commit, commit, config_hash, machine, merge_json, read_json, write_atomic, write_json,
-};
+pub use report::{built_from_a_clean_commit, commit, config_hash, machine, merge_json, write_atomic, write_json};
 pub use results::{ExperimentResults, ProblemEvaluation, RunKey, RunResult, StepEvaluation};
 pub use run::{RunConfig, train_amber, train_cnn};
 pub use table::{markdown as markdown_table, row_label};

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use amber_mesh::Mesh2;
+use amber_stdx::read_json;
 use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
 use amber_tasks::poisson::{Difficulty, PoissonProblem, Split, load_split, read_split};
@@ -17,7 +18,7 @@ use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::profiles::{Task, amber_config, cnn_config};
 use crate::progress::item_bar;
-use crate::report::{merge_json, read_json};
+use crate::report::merge_json;
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
 

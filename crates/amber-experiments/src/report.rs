@@ -1,34 +1,32 @@
-//! Writing results: atomic files, and the record of where numbers came from (commit, machine).
+//! Writing results: files that appear atomically in directories created on the way (amber-stdx's
+//! writers), and the record of where numbers came from (commit, machine).
 
 use std::path::Path;
 
 use anyhow::Context;
 
-/// Writes pretty JSON to `path` atomically (temporary file in the same directory, then rename),
-/// creating parent directories.
+/// Writes pretty JSON to `path` atomically (amber-stdx's `write_json_atomic`), creating parent
+/// directories.
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
-    write_atomic(path, text.as_bytes())
+    create_parent(path)?;
+    Ok(amber_stdx::write_json_atomic(path, value)?)
 }
 
-/// Reads a JSON file, naming it in errors.
-pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    serde_json::from_slice(&bytes).with_context(|| format!("{}: not the expected JSON", path.display()))
-}
-
-/// Writes bytes to `path` atomically, creating parent directories.
+/// Writes bytes to `path` atomically (amber-stdx's `write_atomic`), creating parent directories.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    create_parent(path)?;
+    Ok(amber_stdx::write_atomic(path, bytes)?)
+}
+
+fn create_parent(path: &Path) -> anyhow::Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create directory", dir.display()))?;
     }
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes).with_context(|| format!("{}: cannot write", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot rename into place", path.display()))?;
     Ok(())
 }
 
-/// CPU model, core count, memory and load average, for the record.
+/// CPU model, core count, thread count, memory and load average, for the record: the one
+/// machine description of every results file, benchmarks included.
 pub fn machine() -> serde_json::Value {
     let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
     let cpu = cpuinfo

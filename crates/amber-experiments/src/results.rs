@@ -1,6 +1,7 @@
 //! The results schema every experiment writes (`results.json`): per-problem evaluations are
 //! reduced to one [`RunResult`] per (method, variant, difficulty, seed).
 
+use amber_stdx::quantile;
 use amber_train::{MeshMetrics, Rollout, StepStatus};
 use serde::{Deserialize, Serialize};
 
@@ -124,18 +125,6 @@ impl RunResult {
             train_seconds: key.train_seconds,
             eval_seconds: key.eval_seconds,
             problems: problems.to_vec(),
-        }
-    }
-}
-
-/// Linear-interpolation quantile of sorted values (NaN for none).
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    match sorted.len() {
-        0 => f64::NAN,
-        n => {
-            let x = q * (n - 1) as f64;
-            let (i, frac) = (x.floor() as usize, x.fract());
-            sorted[i] + frac * (sorted[(i + 1).min(n - 1)] - sorted[i])
         }
     }
 }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use amber_mesh::{Mesh, MeshData, read_mesh, write_mesh};
+use amber_stdx::read_json;
 use amber_tasks::Problem;
 use amber_train::{
     AmberModel, CONFIG_FILE, CnnConfig, CnnModel, CnnObserver, CnnStepReport, CnnTraining, Evaluation,
@@ -16,7 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::method::MethodSpec;
 use crate::progress::TrainingProgress;
-use crate::report::{config_hash, read_json, write_json};
+use crate::report::{config_hash, write_json};
 use crate::results::{ProblemEvaluation, RunKey, RunResult};
 
 /// Test problems whose rollouts are kept as meshes (`.vtu`) and drawn in the gallery.

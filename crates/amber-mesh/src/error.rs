@@ -46,3 +46,12 @@ pub enum MeshError {
     #[error("{path}: unsupported mesh format (expected one of {expected})")]
     UnsupportedFormat { path: PathBuf, expected: &'static str },
 }
+
+impl From<amber_stdx::FileError> for MeshError {
+    fn from(e: amber_stdx::FileError) -> Self {
+        match e {
+            amber_stdx::FileError::Io { path, source } => MeshError::Io { path, source },
+            amber_stdx::FileError::Json { path, source } => MeshError::Format { path, message: source.to_string() },
+        }
+    }
+}

@@ -1,5 +1,7 @@
 //! The simplicial mesh type and its per-element geometry.
 
+use nalgebra::{SVector, Vector3};
+
 use crate::MeshError;
 
 /// A conforming simplicial mesh in `D` dimensions (`D` = 2: triangles, `D` = 3: tetrahedra).
@@ -200,35 +202,24 @@ pub fn volume_from_size<const D: usize>(size: f64) -> f64 {
     }
 }
 
-fn sub<const D: usize>(a: [f64; D], b: [f64; D]) -> [f64; D] {
-    std::array::from_fn(|k| a[k] - b[k])
-}
-
-fn dot<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
-    (0..D).map(|k| a[k] * b[k]).sum()
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn angle_between<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
-    let c = dot(a, b) / (dot(a, a) * dot(b, b)).sqrt();
+fn angle_between<const D: usize>(a: SVector<f64, D>, b: SVector<f64, D>) -> f64 {
+    let c = a.dot(&b) / (a.dot(&a) * b.dot(&b)).sqrt();
     c.clamp(-1.0, 1.0).acos().to_degrees()
 }
 
 fn min_triangle_angle<const D: usize>(p: &[[f64; D]]) -> f64 {
-    (0..3).map(|i| angle_between(sub(p[(i + 1) % 3], p[i]), sub(p[(i + 2) % 3], p[i]))).fold(f64::INFINITY, f64::min)
+    let v = |i: usize| SVector::<f64, D>::from(p[i % 3]);
+    (0..3).map(|i| angle_between(v(i + 1) - v(i), v(i + 2) - v(i))).fold(f64::INFINITY, f64::min)
 }
 
 fn min_dihedral_angle<const D: usize>(p: &[[f64; D]]) -> f64 {
-    let p3: Vec<[f64; 3]> = p.iter().map(|q| [q[0], q[1], q[2]]).collect();
+    let v = |i: usize| Vector3::new(p[i][0], p[i][1], p[i][2]);
     let mut min = f64::INFINITY;
     // The dihedral angle at edge (i, j) equals the angle between e×(p_k−p_i) and e×(p_l−p_i).
     for (i, j, k, l) in [(0, 1, 2, 3), (0, 2, 1, 3), (0, 3, 1, 2), (1, 2, 0, 3), (1, 3, 0, 2), (2, 3, 0, 1)] {
-        let e = sub(p3[j], p3[i]);
-        let nk = cross(e, sub(p3[k], p3[i]));
-        let nl = cross(e, sub(p3[l], p3[i]));
+        let e = v(j) - v(i);
+        let nk = e.cross(&(v(k) - v(i)));
+        let nl = e.cross(&(v(l) - v(i)));
         min = min.min(angle_between(nk, nl));
     }
     min

@@ -13,7 +13,7 @@ mod sizing;
 pub use domain::PolygonDomain;
 pub use error::MeshgenError;
 pub use mesh2d::{Mesh2dParams, generate_2d, uniform_mesh_2d};
-pub use quality::{QualityReport, quantile};
+pub use quality::QualityReport;
 pub use sizing::{
     ClampedSize, ConstantSize, FnSize, MeshSizing, PixelGridSizing, SizingField, estimated_element_count,
 };

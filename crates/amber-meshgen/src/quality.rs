@@ -1,6 +1,7 @@
 //! How well a mesh realises a sizing field, and how well shaped its elements are.
 
 use amber_mesh::Mesh;
+use amber_stdx::quantile;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -36,14 +37,4 @@ impl QualityReport {
             mean_min_angle: angles.iter().sum::<f64>() / angles.len().max(1) as f64,
         }
     }
-}
-
-/// Linear-interpolated quantile of sorted data (NaN for empty data).
-pub fn quantile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let x = q * (sorted.len() - 1) as f64;
-    let (i, frac) = (x.floor() as usize, x - x.floor());
-    if i + 1 < sorted.len() { sorted[i] * (1.0 - frac) + sorted[i + 1] * frac } else { sorted[i] }
 }

@@ -8,8 +8,9 @@
 use amber_fem::FemError;
 use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, NodeFeature, project_expert_sizing};
 use amber_mesh::Mesh;
-use amber_meshgen::{MeshgenError, estimated_element_count, quantile};
+use amber_meshgen::{MeshgenError, estimated_element_count};
 use amber_metrics::MetricsError;
+use amber_stdx::quantile;
 use serde::{Deserialize, Serialize};
 
 /// Why one problem's step failed.

@@ -25,7 +25,6 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, io_error};
-use crate::model::{tmp_path, write_atomic};
 use amber_tasks::{Column, MeshState, Problem};
 
 use crate::{BufferEntry, Sample, TargetTransform, TrainingConfig};
@@ -197,7 +196,7 @@ pub(crate) fn commit<'e, const D: usize>(
     let dir = root.join(&name);
     remove_dir_if_present(&dir)?;
     std::fs::rename(&tmp, &dir).map_err(io_error(&dir))?;
-    write_atomic(&root.join(LATEST_FILE), name.as_bytes())?;
+    amber_stdx::write_atomic(&root.join(LATEST_FILE), name.as_bytes())?;
 
     for item in std::fs::read_dir(&root).map_err(io_error(&root))? {
         let path = item.map_err(io_error(&root))?.path();
@@ -240,10 +239,10 @@ fn save_entry<const D: usize>(path: &Path, sample: &Sample<D>) -> Result<()> {
     for c in &sample.state.columns {
         tensors.insert(format!("column.{}", c.name), Tensor::from_slice(&c.values, c.values.len(), cpu)?);
     }
-    let tmp = tmp_path(path);
-    candle_core::safetensors::save(&tensors, &tmp)
-        .map_err(|e| TrainError::Checkpoint { path: tmp.clone(), message: e.to_string() })?;
-    std::fs::rename(&tmp, path).map_err(io_error(path))
+    amber_stdx::write_atomic_via(path, |tmp| {
+        candle_core::safetensors::save(&tensors, tmp)
+            .map_err(|e| TrainError::Checkpoint { path: tmp.into(), message: e.to_string() })
+    })
 }
 
 /// Reads the entry `record` from the checkpoint `dir` and rebuilds its graph and targets.

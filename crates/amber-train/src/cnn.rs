@@ -17,6 +17,7 @@ use amber_cnn::{CnnLoss, PixelGrid, Raster, UNet, UNetConfig};
 use amber_graph::{Aggregation, GraphError, NodeFeature, RunningMoments, VARIANCE_EPSILON};
 use amber_mesh::Mesh;
 use amber_meshgen::SizingField;
+use amber_stdx::{read_json, write_json_atomic};
 use amber_tasks::{MeshLimits, Problem, StepOutcome, generation_step, labels};
 use candle_core::{DType, Device, Tensor};
 use rand_chacha::ChaCha8Rng;
@@ -25,7 +26,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, fingerprints, seeded_stream};
 use crate::error::{Result, TrainError, in_problem, io_error};
-use crate::model::{read_json, write_json};
 use crate::optim::Adam;
 use crate::{BufferEntry, DataConfig, MeshMetrics, Profile, Reference, Rollout, RolloutStep, StepStatus};
 
@@ -306,7 +306,7 @@ impl CnnModel {
     pub fn save(network: &UNet, predictor: &CnnPredictor, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(io_error(dir))?;
         network.save(&dir.join(CNN_WEIGHTS_FILE))?;
-        write_json(&dir.join(CNN_PREDICTOR_FILE), predictor)
+        Ok(write_json_atomic(&dir.join(CNN_PREDICTOR_FILE), predictor)?)
     }
 
     /// Loads a model directory written by [`Self::save`] (a checkpoint directory is one too).
@@ -642,7 +642,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
     /// `out_dir/model`, which it returns.
     pub fn run(&mut self, out_dir: &Path, observer: &mut dyn CnnObserver) -> Result<PathBuf> {
         std::fs::create_dir_all(out_dir).map_err(io_error(out_dir))?;
-        write_json(&out_dir.join(crate::CONFIG_FILE), &self.config)?;
+        write_json_atomic(&out_dir.join(crate::CONFIG_FILE), &self.config)?;
         while self.step < self.config.steps {
             let report = self.train_step()?;
             observer.step(&report, self.config.steps);
@@ -674,7 +674,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         checkpoint::commit(out_dir, self.step, std::iter::empty::<&BufferEntry<D>>(), |dir| {
             self.save_model(dir)?;
             self.optimiser.save(&dir.join(OPTIMISER_FILE))?;
-            write_json(&dir.join(STATE_FILE), &state)
+            Ok(write_json_atomic(&dir.join(STATE_FILE), &state)?)
         })
     }
 }

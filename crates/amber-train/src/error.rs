@@ -45,6 +45,15 @@ impl From<candle_core::Error> for TrainError {
     }
 }
 
+impl From<amber_stdx::FileError> for TrainError {
+    fn from(e: amber_stdx::FileError) -> Self {
+        match e {
+            amber_stdx::FileError::Io { path, source } => TrainError::Io { path, source },
+            amber_stdx::FileError::Json { path, source } => TrainError::Json { path, source },
+        }
+    }
+}
+
 /// `Result` with [`TrainError`].
 pub type Result<T, E = TrainError> = std::result::Result<T, E>;
 

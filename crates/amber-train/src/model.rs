@@ -5,10 +5,11 @@ use std::path::Path;
 
 use amber_graph::{FeatureNormaliser, FeatureSet, GraphBatch};
 use amber_mpn::{GraphInput, Mpn};
+use amber_stdx::{read_json, write_json_atomic};
 use candle_core::{DType, Device};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, TrainError, io_error};
+use crate::error::{Result, io_error};
 use amber_tasks::{MeshLimits, MeshState};
 
 use crate::TargetTransform;
@@ -62,7 +63,7 @@ impl AmberModel {
     pub fn save(network: &Mpn, varmap: &candle_nn::VarMap, predictor: &Predictor, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(io_error(dir))?;
         network.save(varmap, &dir.join(WEIGHTS_FILE))?;
-        write_json(&dir.join(PREDICTOR_FILE), predictor)
+        Ok(write_json_atomic(&dir.join(PREDICTOR_FILE), predictor)?)
     }
 
     /// Loads a model directory written by [`Self::save`] (a training checkpoint directory is
@@ -77,29 +78,4 @@ impl AmberModel {
     pub fn predict<const D: usize>(&self, states: &[&MeshState<D>]) -> Result<Vec<Vec<f64>>> {
         self.predictor.predict(&self.network, states)
     }
-}
-
-/// Writes `value` as pretty JSON, atomically (temporary file, then rename).
-pub(crate) fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
-    let json = serde_json::to_vec_pretty(value).map_err(|source| TrainError::Json { path: path.into(), source })?;
-    write_atomic(path, &json)
-}
-
-/// Reads JSON of type `T`.
-pub(crate) fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T> {
-    let bytes = std::fs::read(path).map_err(io_error(path))?;
-    serde_json::from_slice(&bytes).map_err(|source| TrainError::Json { path: path.into(), source })
-}
-
-/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = tmp_path(path);
-    std::fs::write(&tmp, bytes).map_err(io_error(&tmp))?;
-    std::fs::rename(&tmp, path).map_err(io_error(path))
-}
-
-/// `dir/.name.tmp` for `dir/name`.
-pub(crate) fn tmp_path(path: &Path) -> std::path::PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp"))
 }

@@ -9,6 +9,7 @@ use std::time::Instant;
 use amber_graph::{FeatureNormaliser, GraphBatch};
 use amber_mesh::Mesh;
 use amber_mpn::{GraphInput, Mpn, MpnConfig};
+use amber_stdx::{read_json, write_json_atomic};
 use amber_tasks::{
     LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step, labels, with_inputs,
 };
@@ -22,7 +23,7 @@ use crate::checkpoint::{
     self, AdditionCounts, EntryRecord, OPTIMISER_FILE, RngState, STATE_FILE, TrainingState, fingerprints, seeded_stream,
 };
 use crate::error::{Result, TrainError, in_problem, io_error};
-use crate::model::{WEIGHTS_FILE, read_json, write_json};
+use crate::model::WEIGHTS_FILE;
 use crate::optim::Adam;
 use crate::{
     AmberModel, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, TargetTransform, TrainingConfig,
@@ -352,7 +353,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         observer: &mut dyn TrainingObserver,
     ) -> Result<()> {
         std::fs::create_dir_all(out_dir).map_err(io_error(out_dir))?;
-        write_json(&out_dir.join(CONFIG_FILE), &self.config)?;
+        write_json_atomic(&out_dir.join(CONFIG_FILE), &self.config)?;
         let mut log = TrainingLog::open(&out_dir.join(LOG_FILE), self.step)?;
         let total = self.config.steps;
         while self.step < total {
@@ -407,7 +408,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         checkpoint::commit(out_dir, self.step, self.buffer.entries(), |dir| {
             self.save_model(dir)?;
             self.optimiser.save(&dir.join(OPTIMISER_FILE))?;
-            write_json(&dir.join(STATE_FILE), &state)
+            Ok(write_json_atomic(&dir.join(STATE_FILE), &state)?)
         })
     }
 }
@@ -443,7 +444,7 @@ impl TrainingLog {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
             Err(e) => return Err(io_error(path)(e)),
         };
-        crate::model::write_atomic(path, kept.as_bytes())?;
+        amber_stdx::write_atomic(path, kept.as_bytes())?;
         let file = std::fs::OpenOptions::new().append(true).open(path).map_err(io_error(path))?;
         Ok(Self { file, path: path.into() })
     }

@@ -4,8 +4,8 @@
 //!
 //! Every reader keeps only the simplices of the mesh dimension, drops vertices no kept element
 //! uses (a stray vertex would make an FEM system singular) and flips negatively oriented
-//! elements. Every writer writes to a temporary file beside the target and renames it, so a
-//! reader never sees a half-written mesh.
+//! elements. Every writer writes to a temporary file beside the target, fsyncs it and renames it
+//! (amber-stdx's `write_atomic_with`), so a reader never sees a half-written mesh.
 
 mod json;
 mod msh;
@@ -13,10 +13,7 @@ mod nastran;
 mod vtu;
 
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::io::BufWriter;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::Path;
 
 use crate::{Mesh, MeshError};
 
@@ -140,35 +137,9 @@ pub fn write_mesh<const D: usize>(mesh: &Mesh<D>, path: impl AsRef<Path>, data: 
     }
 }
 
-/// Writes a file through `write` into a temporary file in the same directory, then renames it
-/// over `path`, so the file is either absent, the old one, or complete. Io errors name `path`.
-pub(crate) fn write_atomic(
-    path: &Path,
-    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), MeshError>,
-) -> Result<(), MeshError> {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let io_error = |source| MeshError::Io { path: path.to_owned(), source };
-    let name = path.file_name().ok_or_else(|| io_error(std::io::ErrorKind::InvalidInput.into()))?;
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let tmp: PathBuf = dir.join(format!(
-        ".{}.{}-{}.tmp",
-        name.to_string_lossy(),
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = File::create(&tmp).map_err(io_error).and_then(|file| {
-        let mut w = BufWriter::new(file);
-        write(&mut w)?;
-        let file = w.into_inner().map_err(|e| io_error(e.into_error()))?;
-        file.sync_all().map_err(io_error)?;
-        std::fs::rename(&tmp, path).map_err(io_error)
-    });
-    if result.is_err() {
-        // Best effort: the temporary file may not even exist.
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
+/// Every file this crate writes goes through amber-stdx's atomic writer (temporary file,
+/// fsync, rename); its file errors become [`MeshError::Io`].
+pub(crate) use amber_stdx::write_atomic_with as write_atomic;
 
 /// Maps an io error while writing `path`.
 fn write_error(path: &Path) -> impl Fn(std::io::Error) -> MeshError + '_ {
@@ -265,7 +236,7 @@ impl<'a> Lines<'a> {
 
 /// A unique scratch directory for one test, removed by the caller.
 #[cfg(test)]
-pub(crate) fn test_dir(name: &str) -> PathBuf {
+pub(crate) fn test_dir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("amber-mesh-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -273,8 +244,6 @@ pub(crate) fn test_dir(name: &str) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
-    use std::io::Write;
-
     use super::*;
     use crate::{Mesh2, Mesh3};
 
@@ -327,21 +296,6 @@ mod tests {
         let err = write_mesh(&square(), &path, &MeshData::new().with_cell("h", vec![1.0])).unwrap_err();
         assert!(matches!(err, MeshError::DataLength { len: 1, expected: 2, .. }), "{err}");
         assert!(!path.exists());
-        std::fs::remove_dir_all(dir).unwrap();
-    }
-
-    #[test]
-    fn a_failed_write_leaves_the_old_file_and_no_temporary() {
-        let dir = test_dir("atomic");
-        let path = dir.join("m.json");
-        std::fs::write(&path, "old").unwrap();
-        let err = write_atomic(&path, |w| {
-            w.write_all(b"partial").unwrap();
-            Err(MeshError::Format { path: path.clone(), message: "boom".into() })
-        });
-        assert!(err.is_err());
-        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
         std::fs::remove_dir_all(dir).unwrap();
     }
 

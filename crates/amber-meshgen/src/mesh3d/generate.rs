@@ -9,6 +9,7 @@
 //! with the field's values at its nodes. An element cap bounds both stages: a field asking for
 //! too many elements is a typed error, never a runaway.
 
+use nalgebra::Vector3;
 use rstar::RTree;
 use rstar::primitives::GeomWithData;
 
@@ -229,7 +230,7 @@ fn background_mesh(surface: &Surface, sizes: &[f64]) -> Result<(Mesh3, Vec<f64>)
             hi[k] = hi[k].max(p[k]);
         }
     }
-    let padding = 0.1 * norm(sub(hi, lo));
+    let padding = 0.1 * (Vector3::from(hi) - Vector3::from(lo)).norm();
     let tree = RTree::bulk_load(points.iter().enumerate().map(|(i, &p)| GeomWithData::new(p, i)).collect());
     let mut all = points.to_vec();
     let mut all_sizes = sizes.to_vec();
@@ -289,10 +290,9 @@ fn triangle_curvatures(reference: &Surface) -> Vec<f64> {
     let (v, triangles, faces) = (reference.vertices(), reference.triangles(), reference.face_ids());
     let corners = |t: usize| triangles[t].map(|i| v[i as usize]);
     let unit_normal = |t: usize| {
-        let [a, b, c] = corners(t);
-        let n = cross(sub(b, a), sub(c, a));
-        let l = norm(n);
-        n.map(|x| x / l)
+        let [a, b, c] = corners(t).map(Vector3::from);
+        let n = (b - a).cross(&(c - a));
+        n / n.norm()
     };
     let mut edges: Vec<([u32; 2], usize)> = triangles
         .iter()
@@ -306,9 +306,9 @@ fn triangle_curvatures(reference: &Surface) -> Vec<f64> {
         if e != f || faces[s] != faces[t] {
             continue;
         }
-        let (cs, ct) = (corners(s), corners(t));
-        let distance = norm(sub(centroid(cs[0], cs[1], cs[2]), centroid(ct[0], ct[1], ct[2])));
-        let turn = norm(sub(unit_normal(s), unit_normal(t)));
+        let [cs, ct] = [s, t].map(corners).map(|[a, b, c]| Vector3::from(centroid(a, b, c)));
+        let distance = (cs - ct).norm();
+        let turn = (unit_normal(s) - unit_normal(t)).norm();
         if distance > 0.0 && turn.is_finite() {
             let kappa = turn / distance;
             curvature[s] = curvature[s].max(kappa);
@@ -320,18 +320,6 @@ fn triangle_curvatures(reference: &Surface) -> Vec<f64> {
 
 fn centroid(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
+use nalgebra::Vector3;
 use rstar::{AABB, Envelope};
 
 use super::predicates::{orient2d, orient3d};
@@ -73,19 +74,20 @@ pub(crate) fn triangles_overlap(t: [u32; 3], tc: &Triangle, u: [u32; 3], uc: &Tr
 /// filters always fail. Axes: the normals of the triangles, the cross products of all edge
 /// pairs, and each normal crossed with every edge (the in-plane separations).
 fn clearly_apart(p: &[[f64; 3]], q: &[[f64; 3]]) -> bool {
-    let edges = |x: &[[f64; 3]]| -> Vec<[f64; 3]> {
-        (0..x.len()).filter(|&i| x.len() > 2 || i == 0).map(|i| sub(x[(i + 1) % x.len()], x[i])).collect()
+    let edges = |x: &[[f64; 3]]| -> Vec<Vector3<f64>> {
+        let edge = |i: usize| Vector3::from(x[(i + 1) % x.len()]) - Vector3::from(x[i]);
+        (0..x.len()).filter(|&i| x.len() > 2 || i == 0).map(edge).collect()
     };
     let (ep, eq) = (edges(p), edges(q));
     let scale = p.iter().chain(q).flatten().fold(1.0f64, |m, &c| m.max(c.abs()));
-    let separates = |axis: [f64; 3]| {
-        let length = dot(axis, axis).sqrt();
+    let separates = |axis: Vector3<f64>| {
+        let length = axis.norm();
         if length == 0.0 || !length.is_finite() {
             return false;
         }
         let range = |x: &[[f64; 3]]| {
             x.iter()
-                .map(|&v| dot(axis, v))
+                .map(|&v| axis.dot(&Vector3::from(v)))
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
         };
         let ((plo, phi), (qlo, qhi)) = (range(p), range(q));
@@ -93,23 +95,11 @@ fn clearly_apart(p: &[[f64; 3]], q: &[[f64; 3]]) -> bool {
         let margin = 1e-10 * length * scale;
         plo > qhi + margin || qlo > phi + margin
     };
-    let normals: Vec<[f64; 3]> =
-        [(p, &ep), (q, &eq)].iter().filter(|(x, _)| x.len() == 3).map(|(_, e)| cross(e[0], e[1])).collect();
+    let normals: Vec<Vector3<f64>> =
+        [(p, &ep), (q, &eq)].iter().filter(|(x, _)| x.len() == 3).map(|(_, e)| e[0].cross(&e[1])).collect();
     normals.iter().any(|&n| separates(n))
-        || ep.iter().any(|&a| eq.iter().any(|&b| separates(cross(a, b))))
-        || normals.iter().any(|&n| ep.iter().chain(&eq).any(|&e| separates(cross(n, e))))
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        || ep.iter().any(|a| eq.iter().any(|b| separates(a.cross(b))))
+        || normals.iter().any(|n| ep.iter().chain(&eq).any(|e| separates(n.cross(e))))
 }
 
 /// Drops the coordinate along which the triangle's normal is largest (a projection that keeps
@@ -150,10 +140,9 @@ fn segments_meet_2d(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool 
     on(o1, a, b, c) || on(o2, a, b, d) || on(o3, c, d, a) || on(o4, c, d, b)
 }
 
-fn normal(t: &Triangle) -> [f64; 3] {
-    let u = [0, 1, 2].map(|k| t[1][k] - t[0][k]);
-    let v = [0, 1, 2].map(|k| t[2][k] - t[0][k]);
-    [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+fn normal(t: &Triangle) -> Vector3<f64> {
+    let [a, b, c] = t.map(Vector3::from);
+    (b - a).cross(&(c - a))
 }
 
 /// The axis-aligned bounding box of a triangle.

@@ -1,135 +1,31 @@
-//! Exact orientation predicates for `f64` points: a floating-point filter with Shewchuk's error
-//! bounds, and when it cannot decide, the determinant evaluated exactly in expansion arithmetic
-//! (sums of non-overlapping doubles). Exact as long as no product under- or overflows, which
-//! holds for any coordinates between about 1e-70 and 1e70 in magnitude.
+//! Exact orientation predicates for `f64` points, as `Ordering`s in our sign conventions, on the
+//! `robust` crate (Shewchuk's adaptive predicates, which spade uses too: a floating-point filter
+//! with his error bounds, and where it cannot decide, the determinant in exact expansion
+//! arithmetic). Exact as long as no product under- or overflows, which holds for any
+//! coordinates between about 1e-70 and 1e70 in magnitude.
 
 use std::cmp::Ordering;
 
-/// ε = 2⁻⁵³, the unit roundoff of `f64`.
-const EPS: f64 = f64::EPSILON / 2.0;
-/// Shewchuk's `ccwerrboundA` and `o3derrboundA`: forward error bounds of the plain evaluation.
-const ORIENT2D_BOUND: f64 = (3.0 + 16.0 * EPS) * EPS;
-const ORIENT3D_BOUND: f64 = (7.0 + 56.0 * EPS) * EPS;
+use robust::{Coord, Coord3D};
 
 /// Sign of det[b − a, c − a, d − a], i.e. of the signed volume of tet (a, b, c, d): `Greater`
 /// when d lies on the side the normal (b − a) × (c − a) points to.
 pub(crate) fn orient3d(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> Ordering {
-    // Shewchuk's form det[a − d, b − d, c − d] = −det[b − a, c − a, d − a].
-    let [adx, ady, adz] = [a[0] - d[0], a[1] - d[1], a[2] - d[2]];
-    let [bdx, bdy, bdz] = [b[0] - d[0], b[1] - d[1], b[2] - d[2]];
-    let [cdx, cdy, cdz] = [c[0] - d[0], c[1] - d[1], c[2] - d[2]];
-    let (bc, cb) = (bdy * cdz, bdz * cdy);
-    let (ca, ac) = (cdy * adz, cdz * ady);
-    let (ab, ba) = (ady * bdz, adz * bdy);
-    let det = adx * (bc - cb) + bdx * (ca - ac) + cdx * (ab - ba);
-    let permanent =
-        (bc.abs() + cb.abs()) * adx.abs() + (ca.abs() + ac.abs()) * bdx.abs() + (ab.abs() + ba.abs()) * cdx.abs();
-    let shewchuk = if det.abs() > ORIENT3D_BOUND * permanent {
-        det.partial_cmp(&0.0).unwrap_or(Ordering::Equal)
-    } else {
-        let m = |i: usize, k: usize| {
-            let p = [a, b, c][i];
-            two_diff(p[k], d[k])
-        };
-        let minor =
-            |i: usize, j: usize, k0: usize, k1: usize| sub(&mul(&m(i, k0), &m(j, k1)), &mul(&m(i, k1), &m(j, k0)));
-        let terms =
-            [mul(&m(0, 0), &minor(1, 2, 1, 2)), mul(&m(1, 0), &minor(2, 0, 1, 2)), mul(&m(2, 0), &minor(0, 1, 1, 2))];
-        sign(&add(&add(&terms[0], &terms[1]), &terms[2]))
-    };
-    shewchuk.reverse()
+    let p = |p: [f64; 3]| Coord3D { x: p[0], y: p[1], z: p[2] };
+    // robust's orient3d is Shewchuk's det[a − d, b − d, c − d] = −det[b − a, c − a, d − a].
+    sign(robust::orient3d(p(a), p(b), p(c), p(d))).reverse()
 }
 
 /// Sign of det[b − a, c − a]: `Greater` when a, b, c turn counter-clockwise.
 pub(crate) fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> Ordering {
-    let left = (a[0] - c[0]) * (b[1] - c[1]);
-    let right = (a[1] - c[1]) * (b[0] - c[0]);
-    let det = left - right;
-    if det.abs() > ORIENT2D_BOUND * (left.abs() + right.abs()) {
-        return det.partial_cmp(&0.0).unwrap_or(Ordering::Equal);
-    }
-    let d = |p: [f64; 2], k: usize| two_diff(p[k], c[k]);
-    sign(&sub(&mul(&d(a, 0), &d(b, 1)), &mul(&d(a, 1), &d(b, 0))))
+    let p = |p: [f64; 2]| Coord { x: p[0], y: p[1] };
+    // robust's orient2d is det[a − c, b − c] = det[b − a, c − a].
+    sign(robust::orient2d(p(a), p(b), p(c)))
 }
 
-/// An exact value as a sum of non-overlapping doubles of increasing magnitude, on the stack.
-/// 192 terms is the most `orient3d` needs: a 3×3 determinant of 2-term differences.
-#[derive(Clone, Copy)]
-struct Expansion {
-    len: usize,
-    terms: [f64; 192],
-}
-
-impl Expansion {
-    const ZERO: Self = Self { len: 0, terms: [0.0; 192] };
-
-    fn terms(&self) -> &[f64] {
-        &self.terms[..self.len]
-    }
-
-    /// Adds one double in place (Shewchuk's Grow-Expansion), dropping zero components.
-    fn grow(&mut self, b: f64) {
-        let mut q = b;
-        let mut k = 0;
-        for i in 0..self.len {
-            let (s, h) = two_sum(q, self.terms[i]);
-            if h != 0.0 {
-                self.terms[k] = h;
-                k += 1;
-            }
-            q = s;
-        }
-        if q != 0.0 {
-            self.terms[k] = q;
-            k += 1;
-        }
-        self.len = k;
-    }
-}
-
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let x = a + b;
-    let bv = x - a;
-    let av = x - bv;
-    (x, (a - av) + (b - bv))
-}
-
-/// a − b exactly.
-fn two_diff(a: f64, b: f64) -> Expansion {
-    let mut e = Expansion::ZERO;
-    e.grow(a);
-    e.grow(-b);
-    e
-}
-
-fn add(e: &Expansion, f: &Expansion) -> Expansion {
-    let mut out = *e;
-    f.terms().iter().for_each(|&x| out.grow(x));
-    out
-}
-
-fn sub(e: &Expansion, f: &Expansion) -> Expansion {
-    let mut out = *e;
-    f.terms().iter().for_each(|&x| out.grow(-x));
-    out
-}
-
-fn mul(e: &Expansion, f: &Expansion) -> Expansion {
-    let mut out = Expansion::ZERO;
-    for &x in e.terms() {
-        for &y in f.terms() {
-            let p = x * y;
-            // The fused multiply-add rounds once, so it returns the exact rounding error of p.
-            out.grow(x.mul_add(y, -p));
-            out.grow(p);
-        }
-    }
-    out
-}
-
-/// The largest component decides the sign of a non-overlapping expansion.
-fn sign(e: &Expansion) -> Ordering {
-    e.terms().last().map_or(Ordering::Equal, |x| x.partial_cmp(&0.0).unwrap_or(Ordering::Equal))
+/// The sign of an exact determinant (NaN input: `Equal`).
+fn sign(det: f64) -> Ordering {
+    det.partial_cmp(&0.0).unwrap_or(Ordering::Equal)
 }
 
 #[cfg(test)]
@@ -159,7 +55,67 @@ mod tests {
         p.map(|x| x as f64)
     }
 
+    /// The plain floating-point determinants, for inputs where rounding cannot flip their sign.
+    fn naive3d(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
+        let v = |p: [f64; 3]| nalgebra::Vector3::from(p) - nalgebra::Vector3::from(a);
+        v(b).cross(&v(c)).dot(&v(d))
+    }
+
+    fn naive2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+        let v = |p: [f64; 2]| nalgebra::Vector2::from(p) - nalgebra::Vector2::from(a);
+        v(b).perp(&v(c))
+    }
+
+    /// Eighths of integers below 2¹⁰: differences, products and sums of them are exact in
+    /// `f64`, so the plain determinant of such points is exact.
+    fn eighths(n: [i32; 2]) -> [f64; 2] {
+        n.map(|k| f64::from(k) / 8.0)
+    }
+
     proptest::proptest! {
+        // Unit-sized points whose determinant is far above its rounding error (about 1e-15).
+        #[test]
+        fn orient3d_agrees_with_the_plain_determinant_on_well_conditioned_points(
+            a in proptest::array::uniform3(-1.0..1.0f64),
+            b in proptest::array::uniform3(-1.0..1.0f64),
+            c in proptest::array::uniform3(-1.0..1.0f64),
+            d in proptest::array::uniform3(-1.0..1.0f64),
+        ) {
+            let det = naive3d(a, b, c, d);
+            proptest::prop_assume!(det.abs() > 1e-9);
+            proptest::prop_assert_eq!(orient3d(a, b, c, d), sign(det));
+        }
+
+        #[test]
+        fn orient2d_agrees_with_the_plain_determinant_on_well_conditioned_points(
+            a in proptest::array::uniform2(-1.0..1.0f64),
+            b in proptest::array::uniform2(-1.0..1.0f64),
+            c in proptest::array::uniform2(-1.0..1.0f64),
+        ) {
+            let det = naive2d(a, b, c);
+            proptest::prop_assume!(det.abs() > 1e-9);
+            proptest::prop_assert_eq!(orient2d(a, b, c), sign(det));
+        }
+
+        // Points on the tilted plane z = x/2 − y/4 + 3 (and c on the line through a and b), with
+        // coordinates for which the plain determinant is exactly 0 too.
+        #[test]
+        fn exactly_coplanar_and_collinear_points_are_equal(
+            xy in proptest::array::uniform4(proptest::array::uniform2(-1000i32..1000)),
+            t in -8i32..8,
+        ) {
+            let [a, b, c, d] = xy.map(|n| {
+                let [x, y] = eighths(n);
+                [x, y, x / 2.0 - y / 4.0 + 3.0]
+            });
+            proptest::prop_assert_eq!(naive3d(a, b, c, d), 0.0);
+            proptest::prop_assert_eq!(orient3d(a, b, c, d), Ordering::Equal);
+            let [p, q] = [eighths(xy[0]), eighths(xy[1])];
+            let r = [0, 1].map(|k| p[k] + f64::from(t) * (q[k] - p[k]));
+            proptest::prop_assert_eq!(naive2d(p, q, r), 0.0);
+            proptest::prop_assert_eq!(orient2d(p, q, r), Ordering::Equal);
+        }
+
         // d = b + c − a (+ a unit nudge) is exactly coplanar with a, b, c (or one unit off the
         // plane), with coordinates so large that the plain determinant is pure rounding noise.
         #[test]

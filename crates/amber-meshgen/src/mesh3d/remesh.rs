@@ -17,6 +17,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 
+use nalgebra::Vector3;
 use rstar::primitives::Line;
 use rstar::{AABB, Envelope, PointDistance, RTree, RTreeObject};
 
@@ -103,7 +104,7 @@ impl<S: SizingField<3>> Context<'_, S> {
     /// edge) stays close enough to the reference at its midpoint.
     fn follows_reference(&self, p: [f64; 3], q: [f64; 3], kind: Kind, h: f64) -> bool {
         let mid = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
-        let deviation = norm(sub(self.projector.project(mid, kind), mid));
+        let deviation = (Vector3::from(self.projector.project(mid, kind)) - Vector3::from(mid)).norm();
         deviation <= self.params.max_relative_deviation * h
     }
 }
@@ -134,7 +135,7 @@ struct Projector {
     /// The triangles of every curved face.
     faces: HashMap<i32, RTree<RefTriangle>>,
     /// Point and unit normal of every planar face.
-    planes: HashMap<i32, ([f64; 3], [f64; 3])>,
+    planes: HashMap<i32, (Vector3<f64>, Vector3<f64>)>,
     curves: HashMap<(i32, i32), RTree<Line<[f64; 3]>>>,
 }
 
@@ -158,7 +159,7 @@ impl Projector {
                 curves.entry((f.min(g), f.max(g))).or_default().push(Line::new(v[a as usize], v[b as usize]));
             }
         }
-        let planes: HashMap<i32, ([f64; 3], [f64; 3])> =
+        let planes: HashMap<i32, (Vector3<f64>, Vector3<f64>)> =
             faces.iter().filter_map(|(&id, tris)| Some((id, plane_of(tris)?))).collect();
         Self {
             faces: faces
@@ -174,7 +175,10 @@ impl Projector {
     fn project(&self, p: [f64; 3], kind: Kind) -> [f64; 3] {
         match kind {
             Kind::Face(f) => match self.planes.get(&f) {
-                Some(&(origin, n)) => axpy(p, -dot(sub(p, origin), n), n),
+                Some(&(origin, n)) => {
+                    let p = Vector3::from(p);
+                    (p + n * -(p - origin).dot(&n)).into()
+                }
                 None => self.faces.get(&f).and_then(|tree| tree.nearest_neighbor(p)).map_or(p, |t| t.closest(p)),
             },
             Kind::Curve(f, g) => {
@@ -191,18 +195,21 @@ impl Projector {
 
 /// The plane of a face whose triangles all lie in one (within 10⁻⁵ of the face's extent,
 /// which float32 STL coordinates respect and any real bend or hole wall exceeds).
-fn plane_of(triangles: &[RefTriangle]) -> Option<([f64; 3], [f64; 3])> {
-    let corners = || triangles.iter().flat_map(|t| t.0);
+fn plane_of(triangles: &[RefTriangle]) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    let corners = || triangles.iter().flat_map(|t| t.0).map(Vector3::from);
     let count = 3.0 * triangles.len() as f64;
-    let origin = corners().fold([0.0; 3], add).map(|c| c / count);
-    let n = triangles.iter().fold([0.0; 3], |acc, t| add(acc, cross(sub(t.0[1], t.0[0]), sub(t.0[2], t.0[0]))));
-    let length = norm(n);
+    let origin = corners().fold(Vector3::zeros(), |acc, c| acc + c) / count;
+    let n = triangles.iter().fold(Vector3::zeros(), |acc, t| {
+        let [a, b, c] = t.0.map(Vector3::from);
+        acc + (b - a).cross(&(c - a))
+    });
+    let length = n.norm();
     if length == 0.0 {
         return None;
     }
-    let n = n.map(|c| c / length);
-    let extent = corners().map(|c| norm(sub(c, origin))).fold(0.0, f64::max);
-    corners().all(|c| dot(sub(c, origin), n).abs() <= 1e-5 * extent).then_some((origin, n))
+    let n = n / length;
+    let extent = corners().map(|c| (c - origin).norm()).fold(0.0, f64::max);
+    corners().all(|c| (c - origin).dot(&n).abs() <= 1e-5 * extent).then_some((origin, n))
 }
 
 /// A reference triangle in an R-tree that answers distance queries exactly.
@@ -211,36 +218,37 @@ struct RefTriangle([[f64; 3]; 3]);
 impl RefTriangle {
     /// Closest point of the triangle to `p` (Ericson, Real-Time Collision Detection §5.1.5).
     fn closest(&self, p: [f64; 3]) -> [f64; 3] {
-        let [a, b, c] = self.0;
-        let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-        let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+        let [a, b, c] = self.0.map(Vector3::from);
+        let p = Vector3::from(p);
+        let (ab, ac, ap) = (b - a, c - a, p - a);
+        let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
         if d1 <= 0.0 && d2 <= 0.0 {
-            return a;
+            return a.into();
         }
-        let bp = sub(p, b);
-        let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+        let bp = p - b;
+        let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
         if d3 >= 0.0 && d4 <= d3 {
-            return b;
+            return b.into();
         }
         let vc = d1 * d4 - d3 * d2;
         if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-            return axpy(a, d1 / (d1 - d3), ab);
+            return (a + ab * (d1 / (d1 - d3))).into();
         }
-        let cp = sub(p, c);
-        let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+        let cp = p - c;
+        let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
         if d6 >= 0.0 && d5 <= d6 {
-            return c;
+            return c.into();
         }
         let vb = d5 * d2 - d1 * d6;
         if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-            return axpy(a, d2 / (d2 - d6), ac);
+            return (a + ac * (d2 / (d2 - d6))).into();
         }
         let va = d3 * d6 - d5 * d4;
         if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-            return axpy(b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), sub(c, b));
+            return (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))).into();
         }
         let denom = 1.0 / (va + vb + vc);
-        axpy(axpy(a, vb * denom, ab), vc * denom, ac)
+        (a + ab * (vb * denom) + ac * (vc * denom)).into()
     }
 }
 
@@ -254,8 +262,7 @@ impl RTreeObject for RefTriangle {
 
 impl PointDistance for RefTriangle {
     fn distance_2(&self, p: &[f64; 3]) -> f64 {
-        let q = self.closest(*p);
-        dot(sub(q, *p), sub(q, *p))
+        (Vector3::from(self.closest(*p)) - Vector3::from(*p)).norm_squared()
     }
 }
 
@@ -310,7 +317,7 @@ impl WorkMesh {
         live.map(|t| {
             let tri = self.triangles[t];
             let h = tri.iter().map(|&v| self.h[v as usize]).sum::<f64>() / 3.0;
-            0.5 * norm(self.normal(tri)) / (3f64.sqrt() / 4.0 * h * h)
+            0.5 * self.normal(tri).norm() / (3f64.sqrt() / 4.0 * h * h)
         })
         .sum()
     }
@@ -349,7 +356,7 @@ impl WorkMesh {
     }
 
     fn length(&self, a: u32, b: u32) -> f64 {
-        norm(sub(self.pos[a as usize], self.pos[b as usize]))
+        (Vector3::from(self.pos[a as usize]) - Vector3::from(self.pos[b as usize])).norm()
     }
 
     /// The target length of edge (a, b): the mean of the sizes at its ends.
@@ -357,9 +364,9 @@ impl WorkMesh {
         0.5 * (self.h[a as usize] + self.h[b as usize])
     }
 
-    fn normal(&self, tri: [u32; 3]) -> [f64; 3] {
-        let [a, b, c] = tri.map(|v| self.pos[v as usize]);
-        cross(sub(b, a), sub(c, a))
+    fn normal(&self, tri: [u32; 3]) -> Vector3<f64> {
+        let [a, b, c] = tri.map(|v| Vector3::from(self.pos[v as usize]));
+        (b - a).cross(&(c - a))
     }
 
     fn quality(&self, tri: [u32; 3]) -> f64 {
@@ -414,7 +421,7 @@ impl WorkMesh {
         let (p, q) = (self.pos[a as usize], self.pos[b as usize]);
         let mid = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]));
         let projected = context.projector.project(mid, kind);
-        if norm(sub(projected, mid)) > 0.25 * self.length(a, b) {
+        if (Vector3::from(projected) - Vector3::from(mid)).norm() > 0.25 * self.length(a, b) {
             return Ok(None);
         }
         let halves = [t1, t2].map(|t| {
@@ -424,9 +431,9 @@ impl WorkMesh {
         });
         let keeps_side = halves.iter().all(|&(t, x, y, c)| {
             let old = self.normal(self.triangles[t as usize]);
-            let [px, py, pc] = [x, y, c].map(|v| self.pos[v as usize]);
-            dot(cross(sub(projected, px), sub(pc, px)), old) > 0.0
-                && dot(cross(sub(py, projected), sub(pc, projected)), old) > 0.0
+            let [px, py, pc] = [x, y, c].map(|v| Vector3::from(self.pos[v as usize]));
+            let pm = Vector3::from(projected);
+            (pm - px).cross(&(pc - px)).dot(&old) > 0.0 && (py - pm).cross(&(pc - pm)).dot(&old) > 0.0
         });
         let at = if keeps_side { projected } else { mid };
         let m = self.pos.len() as u32;
@@ -526,7 +533,7 @@ impl WorkMesh {
         for &(t, new) in &moved {
             let old = self.triangles[t as usize];
             let q = self.quality(new);
-            if dot(self.normal(old), self.normal(new)) <= 0.0 || (q < MIN_QUALITY && q < self.quality(old)) {
+            if self.normal(old).dot(&self.normal(new)) <= 0.0 || (q < MIN_QUALITY && q < self.quality(old)) {
                 return false;
             }
         }
@@ -594,9 +601,9 @@ impl WorkMesh {
             if !(better_valence && new_quality >= 0.9 * old_quality || new_quality >= 1.25 * old_quality) {
                 continue;
             }
-            let old = add(self.normal(self.triangles[t1 as usize]), self.normal(self.triangles[t2 as usize]));
+            let old = self.normal(self.triangles[t1 as usize]) + self.normal(self.triangles[t2 as usize]);
             let (n1, n2) = (self.normal(new1), self.normal(new2));
-            if dot(n1, old) <= 0.0 || dot(n2, old) <= 0.0 || dot(n1, n2) <= 0.0 {
+            if n1.dot(&old) <= 0.0 || n2.dot(&old) <= 0.0 || n1.dot(&n2) <= 0.0 {
                 continue;
             }
             let kind = Kind::Face(self.face[t1 as usize]);
@@ -644,21 +651,20 @@ impl WorkMesh {
             if neighbours.is_empty() {
                 continue;
             }
-            let centroid = neighbours
-                .iter()
-                .fold([0.0; 3], |acc, &x| add(acc, self.pos[x as usize]))
-                .map(|c| c / neighbours.len() as f64);
-            let mut step = sub(centroid, p);
+            let centroid =
+                neighbours.iter().fold(Vector3::zeros(), |acc, &x| acc + Vector3::from(self.pos[x as usize]))
+                    / neighbours.len() as f64;
+            let mut step = centroid - Vector3::from(p);
             let around = &self.around[v as usize];
             if let Kind::Face(_) = kind {
-                let n = around.iter().fold([0.0; 3], |acc, &t| add(acc, self.normal(self.triangles[t as usize])));
-                let nn = dot(n, n);
+                let n = around.iter().fold(Vector3::zeros(), |acc, &t| acc + self.normal(self.triangles[t as usize]));
+                let nn = n.dot(&n);
                 if nn > 0.0 {
-                    step = axpy(step, -dot(step, n) / nn, n);
+                    step += n * (-step.dot(&n) / nn);
                 }
             }
-            let target = context.projector.project(add(p, step), kind);
-            let before: Vec<([f64; 3], f64)> = around
+            let target = context.projector.project((Vector3::from(p) + step).into(), kind);
+            let before: Vec<(Vector3<f64>, f64)> = around
                 .iter()
                 .map(|&t| (self.normal(self.triangles[t as usize]), self.quality(self.triangles[t as usize])))
                 .collect();
@@ -666,7 +672,7 @@ impl WorkMesh {
             let acceptable = around.iter().zip(&before).all(|(&t, &(normal, q))| {
                 let tri = self.triangles[t as usize];
                 let q_new = self.quality(tri);
-                dot(self.normal(tri), normal) > 0.0 && (q_new >= MIN_QUALITY || q_new >= q)
+                self.normal(tri).dot(&normal) > 0.0 && (q_new >= MIN_QUALITY || q_new >= q)
             });
             if acceptable {
                 moved.push(v);
@@ -678,7 +684,7 @@ impl WorkMesh {
         // Sizes follow their vertex once it has moved by a tenth of its size.
         for v in moved {
             let p = self.pos[v as usize];
-            if norm(sub(p, self.sized_at[v as usize])) > 0.1 * self.h[v as usize] {
+            if (Vector3::from(p) - Vector3::from(self.sized_at[v as usize])).norm() > 0.1 * self.h[v as usize] {
                 self.h[v as usize] = context.size(p)?;
                 self.sized_at[v as usize] = p;
             }
@@ -780,35 +786,10 @@ impl WorkMesh {
 }
 
 /// 4√3·area / Σ edge²: 1 for an equilateral triangle, 0 for a degenerate one.
-fn quality([a, b, c]: [[f64; 3]; 3]) -> f64 {
-    let squared = |p: [f64; 3], q: [f64; 3]| dot(sub(p, q), sub(p, q));
-    let sum = squared(a, b) + squared(b, c) + squared(c, a);
-    if sum > 0.0 { 2.0 * 3f64.sqrt() * norm(cross(sub(b, a), sub(c, a))) / sum } else { 0.0 }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-/// a + s·b.
-fn axpy(a: [f64; 3], s: f64, b: [f64; 3]) -> [f64; 3] {
-    [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
+fn quality(corners: [[f64; 3]; 3]) -> f64 {
+    let [a, b, c] = corners.map(Vector3::from);
+    let sum = (a - b).norm_squared() + (b - c).norm_squared() + (c - a).norm_squared();
+    if sum > 0.0 { 2.0 * 3f64.sqrt() * (b - a).cross(&(c - a)).norm() / sum } else { 0.0 }
 }
 
 #[cfg(test)]
@@ -833,7 +814,7 @@ mod tests {
             .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
             .map(|(a, b)| {
                 let (p, q) = (v[a as usize], v[b as usize]);
-                norm(sub(p, q)) / h([0, 1, 2].map(|k| 0.5 * (p[k] + q[k])))
+                (Vector3::from(p) - Vector3::from(q)).norm() / h([0, 1, 2].map(|k| 0.5 * (p[k] + q[k])))
             })
             .collect();
         r.sort_by(f64::total_cmp);
