@@ -61,8 +61,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("amber-fem", &["amber-mesh", "amber-meshgen"]),
     ("amber-graph", &["amber-mesh"]),
     ("amber-metrics", &["amber-mesh"]),
-    ("amber-mpn", &["amber-graph"]),
-    ("amber-cnn", &["amber-mesh", "amber-meshgen", "amber-graph"]),
+    ("amber-nn", &[]),
+    ("amber-mpn", &["amber-graph", "amber-nn"]),
+    ("amber-cnn", &["amber-mesh", "amber-meshgen", "amber-graph", "amber-nn"]),
     ("amber-tasks", &["amber-mesh", "amber-meshgen", "amber-fem", "amber-graph", "amber-metrics"]),
     (
         "amber-train",
