@@ -40,12 +40,6 @@ pub enum TrainError {
     Checkpoint { path: PathBuf, message: String },
 }
 
-impl From<candle_core::Error> for TrainError {
-    fn from(e: candle_core::Error) -> Self {
-        TrainError::Network(MpnError::Candle(e))
-    }
-}
-
 /// `Result` with [`TrainError`].
 pub type Result<T, E = TrainError> = std::result::Result<T, E>;
 

@@ -21,7 +21,6 @@ mod console;
 mod error;
 mod inference;
 mod model;
-mod optim;
 mod target;
 mod task;
 mod train;
@@ -38,7 +37,6 @@ pub use inference::{
     Evaluation, EvaluationSummary, MeshMetrics, Reference, Rollout, RolloutStep, StepStatus, StepSummary, rollouts,
 };
 pub use model::{AmberModel, Predictor, WEIGHTS_FILE};
-pub use optim::Adam;
 pub use target::{TargetTransform, softplus, softplus_inverse};
 pub use task::{
     Column, LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError,
