@@ -8,8 +8,9 @@ use std::process::Command;
 use std::time::Instant;
 
 use amber_cnn::{CnnLoss, UNet, UNetConfig};
-use amber_mpn::{TrainConfig, Trainer};
+use amber_nn::Adam;
 use amber_stdx::median;
+use amber_train::CnnConfig;
 use anyhow::{Context, bail};
 use candle_core::{DType, Device, Tensor};
 use rand::rngs::StdRng;
@@ -121,7 +122,7 @@ fn bench_ours(case: &Case, args: &Args) -> anyhow::Result<Value> {
         initial_channels: args.channels,
         depth: 4,
     };
-    let net = UNet::init(config, 0, DType::F32)?;
+    let net = UNet::init(config, 0)?;
     let spatial = vec![case.resolution; case.spatial_axes];
     let input_shape: Vec<usize> = [1, case.in_channels].into_iter().chain(spatial.iter().copied()).collect();
     let label_shape: Vec<usize> = [1, 1].into_iter().chain(spatial.iter().copied()).collect();
@@ -133,13 +134,15 @@ fn bench_ours(case: &Case, args: &Args) -> anyhow::Result<Value> {
     let x = random(&input_shape, -1.0, 1.0)?;
     let y = random(&label_shape, 0.0, 1.0)?;
     let mask = Tensor::ones(label_shape.as_slice(), DType::F32, &Device::Cpu)?;
-    let mut trainer = Trainer::new(net.varmap(), &TrainConfig::default())?;
+    // The Adam that trains, with the paper's settings.
+    let paper = CnnConfig::paper();
+    let mut adam = Adam::new(net.varmap(), paper.max_grad_norm)?;
     let mut forward_s = Vec::new();
     let mut train_step = || -> anyhow::Result<()> {
         let started = Instant::now();
         let loss = CnnLoss::Mse.loss(&net.forward_train(&x)?, &y, &mask)?;
         forward_s.push(started.elapsed().as_secs_f64());
-        trainer.step(&loss)?;
+        adam.step(&loss, paper.learning_rate)?;
         Ok(())
     };
     let load_average_before = load_average();

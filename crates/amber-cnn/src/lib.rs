@@ -3,7 +3,9 @@
 //! bounding box ([`PixelGrid`]), a candle U-Net for both dimensions ([`UNet`]) built on this
 //! crate's own convolution, transposed convolution, max-pooling and fused BatchNorm+ReLU ops
 //! (candle has no 3D ops, a wrong `max_pool2d` backward and norms that drop gradients), the
-//! losses of the paper and its ablations ([`CnnLoss`]), and model files (safetensors + JSON).
+//! losses of the paper and its ablations ([`CnnLoss`]), model files (safetensors + JSON), and
+//! a training handle ([`CnnTrainer`]: the images, the network and `amber-nn`'s Adam) that, like
+//! [`UNet::predict`], takes and returns plain slices.
 //!
 //! This crate sees meshes only to rasterise them and knows nothing of FEM, mesh generation, the
 //! training loop or metrics: those live in `amber-train`, which drives it.
@@ -12,9 +14,11 @@ mod error;
 mod loss;
 pub mod ops;
 mod raster;
+mod train;
 mod unet;
 
 pub use error::{CnnError, Result};
 pub use loss::CnnLoss;
 pub use raster::{PixelGrid, Raster};
+pub use train::{CnnStep, CnnTrainer, TrainingImages};
 pub use unet::{UNet, UNetConfig};

@@ -236,16 +236,16 @@ impl UNet {
         Ok(Self { config, varmap: p.finish()?, down, bottleneck, up, out_weight, out_bias })
     }
 
-    /// A freshly initialised network (parameters drawn from `seed`).
-    pub fn init(config: UNetConfig, seed: u64, dtype: DType) -> Result<Self> {
-        Self::build(config, Source::Seeded(Box::new(ChaCha8Rng::seed_from_u64(seed))), dtype)
+    /// A freshly initialised f32 network (parameters drawn from `seed`).
+    pub fn init(config: UNetConfig, seed: u64) -> Result<Self> {
+        Self::build(config, Source::Seeded(Box::new(ChaCha8Rng::seed_from_u64(seed))), DType::F32)
     }
 
-    /// The network of a weights file written by [`Self::save`], with `config`.
-    pub fn load(config: UNetConfig, weights: &Path, dtype: DType) -> Result<Self> {
+    /// The f32 network of a weights file written by [`Self::save`], with `config`.
+    pub fn load(config: UNetConfig, weights: &Path) -> Result<Self> {
         let tensors = candle_core::safetensors::load(weights, &Device::Cpu)
             .map_err(|e| CnnError::ModelFile { path: weights.into(), message: e.to_string() })?;
-        Self::build(config, Source::File { path: weights.into(), tensors }, dtype)
+        Self::build(config, Source::File { path: weights.into(), tensors }, DType::F32)
     }
 
     /// Writes every parameter and running statistic to `weights` (safetensors, atomically: a
@@ -280,6 +280,12 @@ impl UNet {
     /// Evaluation forward: BatchNorm on running statistics, nothing recorded for autograd.
     pub fn forward(&self, x: &Tensor) -> Result<Tensor> {
         self.forward_with(x, false)
+    }
+
+    /// Evaluation forward of channel-major `input` data of `shape` `(N, in_channels,
+    /// spatial...)`: the `(N, 1, spatial...)` output, flattened.
+    pub fn predict(&self, input: &[f32], shape: &[usize]) -> Result<Vec<f32>> {
+        Ok(self.forward(&Tensor::from_slice(input, shape, &Device::Cpu)?)?.flatten_all()?.to_vec1()?)
     }
 
     fn forward_with(&self, x: &Tensor, train: bool) -> Result<Tensor> {
@@ -329,7 +335,7 @@ mod tests {
     #[test]
     fn every_parameter_gets_a_gradient_in_2d_and_3d() {
         for (axes, dims) in [(2, vec![2, 2, 8, 12]), (3, vec![1, 2, 4, 8, 4])] {
-            let net = UNet::init(config(axes), 0, DType::F32).unwrap();
+            let net = UNet::init(config(axes), 0).unwrap();
             let y = net.forward_train(&input(&dims, 1)).unwrap();
             assert_eq!(y.dims()[1..], [&[1], &dims[2..]].concat()[..]);
             let grads = y.sqr().unwrap().sum_all().unwrap().backward().unwrap();
@@ -345,8 +351,7 @@ mod tests {
         // PyTorch's 2D U-Net with 32 channels, depth 4, 4 inputs has 7,766,273 parameters; it
         // has a bias in each of the 18 convolutions followed by BatchNorm, which this one omits.
         let net =
-            UNet::init(UNetConfig { spatial_axes: 2, in_channels: 4, initial_channels: 32, depth: 4 }, 0, DType::F32)
-                .unwrap();
+            UNet::init(UNetConfig { spatial_axes: 2, in_channels: 4, initial_channels: 32, depth: 4 }, 0).unwrap();
         let biases: usize =
             [32, 32, 64, 64, 128, 128, 256, 256, 512, 512, 256, 256, 128, 128, 64, 64, 32, 32].iter().sum();
         assert_eq!(net.parameter_count() + biases, 7_766_273);
@@ -354,7 +359,7 @@ mod tests {
 
     #[test]
     fn running_statistics_move_towards_the_batch_and_round_trip_through_a_file() {
-        let net = UNet::init(config(2), 3, DType::F32).unwrap();
+        let net = UNet::init(config(2), 3).unwrap();
         let x = input(&[2, 2, 8, 8], 4);
         let before = net.forward(&x).unwrap();
         net.forward_train(&x).unwrap();
@@ -363,21 +368,21 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("unet.safetensors");
         net.save(&path).unwrap();
-        let loaded = UNet::load(config(2), &path, DType::F32).unwrap();
+        let loaded = UNet::load(config(2), &path).unwrap();
         let again = loaded.forward(&x).unwrap();
         assert_eq!(
             again.flatten_all().unwrap().to_vec1::<f32>().unwrap(),
             after.flatten_all().unwrap().to_vec1::<f32>().unwrap()
         );
         let other = UNetConfig { initial_channels: 8, ..config(2) };
-        assert!(matches!(UNet::load(other, &path, DType::F32), Err(CnnError::ModelFile { .. })));
+        assert!(matches!(UNet::load(other, &path), Err(CnnError::ModelFile { .. })));
     }
 
     #[test]
     fn inputs_of_the_wrong_shape_are_errors() {
-        let net = UNet::init(config(2), 0, DType::F32).unwrap();
+        let net = UNet::init(config(2), 0).unwrap();
         assert!(matches!(net.forward(&input(&[1, 2, 6, 8], 0)), Err(CnnError::Shape(_))));
         assert!(matches!(net.forward(&input(&[1, 3, 8, 8], 0)), Err(CnnError::Shape(_))));
-        assert!(UNet::init(UNetConfig { spatial_axes: 4, ..config(2) }, 0, DType::F32).is_err());
+        assert!(UNet::init(UNetConfig { spatial_axes: 4, ..config(2) }, 0).is_err());
     }
 }

@@ -3,7 +3,9 @@
 //! make it fast enough to train on CPUs.
 //!
 //! Input is an [`amber_graph::GraphBatch`]; this crate knows nothing of meshes, meshing, labels
-//! or the training loop around a step. Only the fused ops in `ops` touch raw tensor storage.
+//! or the training loop around a step. [`MpnTrainer`] (one training step: forward, loss, Adam
+//! from `amber-nn`) and [`Mpn::predict`] / [`Mpn::load`] take and return plain slices, so the
+//! training loop never sees a tensor. Only the fused ops in `ops` touch raw tensor storage.
 //!
 //! ```
 //! use amber_mpn::{GraphInput, Mpn, MpnConfig};
@@ -31,4 +33,4 @@ pub use config::{MpnConfig, OutputTransform};
 pub use error::{MpnError, Result};
 pub use graph::{GraphInput, Topology};
 pub use model::Mpn;
-pub use train::{TrainConfig, Trainer, clip_grad_norm, grad_norm, mse};
+pub use train::{MpnTrainer, StepLoss};

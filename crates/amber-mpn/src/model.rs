@@ -171,13 +171,15 @@ impl Mpn {
         varmap.save(path).map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })
     }
 
-    /// Loads a checkpoint written by [`Mpn::save`] as plain tensors, for inference.
-    pub fn load(path: &Path, dtype: DType, device: &Device) -> Result<Self> {
+    /// Loads a checkpoint written by [`Mpn::save`] as plain f32 tensors on the CPU, for
+    /// inference.
+    pub fn load(path: &Path) -> Result<Self> {
+        let (dtype, device) = (DType::F32, Device::Cpu);
         let config = read_config(path)?;
         let checkpoint_err = |e: candle_core::Error| MpnError::Checkpoint { path: path.into(), message: e.to_string() };
-        let tensors: HashMap<String, Tensor> = candle_core::safetensors::load(path, device).map_err(checkpoint_err)?;
+        let tensors: HashMap<String, Tensor> = candle_core::safetensors::load(path, &device).map_err(checkpoint_err)?;
         let stored = tensors.len();
-        let model = match Self::new(config, VarBuilder::from_tensors(tensors, dtype, device)) {
+        let model = match Self::new(config, VarBuilder::from_tensors(tensors, dtype, &device)) {
             Err(MpnError::Candle(e)) => return Err(checkpoint_err(e)),
             other => other?,
         };
@@ -185,9 +187,10 @@ impl Mpn {
         Ok(model)
     }
 
-    /// Loads a checkpoint written by [`Mpn::save`] into new variables, to resume training.
-    pub fn load_trainable(path: &Path, dtype: DType, device: &Device) -> Result<(Self, VarMap)> {
-        let (model, mut varmap) = Self::init(read_config(path)?, 0, dtype, device)?;
+    /// Loads a checkpoint written by [`Mpn::save`] into new f32 variables on the CPU, to resume
+    /// training.
+    pub fn load_trainable(path: &Path) -> Result<(Self, VarMap)> {
+        let (model, mut varmap) = Self::init(read_config(path)?, 0, DType::F32, &Device::Cpu)?;
         // `VarMap::load` overwrites the variables the model created (shape-checked); it would
         // load nothing into an empty map.
         varmap.load(path).map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })?;
@@ -281,10 +284,11 @@ impl Mpn {
         }
     }
 
-    /// Evaluation-mode predictions for a batch, one per node.
+    /// Evaluation-mode predictions for a batch, one per node (on plain tensors: no autograd
+    /// graph is recorded, even for a network of variables).
     pub fn predict(&self, batch: &GraphBatch) -> Result<Vec<f32>> {
         let graph = GraphInput::from_batch(batch, self.dtype, self.node_encoder.weight.device())?;
-        Ok(self.forward(&graph)?.to_dtype(DType::F32)?.to_vec1()?)
+        Ok(self.for_inference().forward(&graph)?.to_dtype(DType::F32)?.to_vec1()?)
     }
 
     fn encode(&self, g: &GraphInput) -> Result<(Tensor, Tensor)> {

@@ -1,87 +1,94 @@
-//! One optimisation step as in the reference: backward, global gradient-norm clipping, Adam.
+//! Training the network behind plain slices: [`MpnTrainer`] owns the network, its variables and
+//! the Adam optimiser, and takes one step (training-mode forward, mean squared error, backward,
+//! clipping, update) on a [`GraphBatch`] and its targets.
 
-use candle_core::backprop::GradStore;
-use candle_core::{DType, Tensor, Var};
-use candle_nn::{AdamW, Optimizer, ParamsAdamW, VarMap};
-use serde::{Deserialize, Serialize};
+use std::path::Path;
 
-use crate::error::Result;
+use amber_graph::GraphBatch;
+use amber_nn::Adam;
+use candle_core::{DType, Device, Tensor};
+use candle_nn::VarMap;
+use rand::Rng;
 
-/// Optimiser settings (spec §5: Adam, lr 3e-4, clip 0.5).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct TrainConfig {
-    pub learning_rate: f64,
-    /// Global L2 norm the gradients are scaled down to, if set.
-    pub max_grad_norm: Option<f64>,
+use crate::error::{MpnError, Result};
+use crate::{GraphInput, Mpn, MpnConfig};
+
+/// What one training step measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepLoss {
+    /// Mean squared error of the batch.
+    pub loss: f64,
+    /// The squared error of every node, in batch order.
+    pub squared_errors: Vec<f32>,
+    /// Global gradient norm before clipping.
+    pub grad_norm: f64,
 }
 
-impl Default for TrainConfig {
-    fn default() -> Self {
-        Self { learning_rate: 3e-4, max_grad_norm: Some(0.5) }
-    }
+/// A trainable network (f32, on the CPU) with its variables and optimiser.
+pub struct MpnTrainer {
+    network: Mpn,
+    varmap: VarMap,
+    optimiser: Adam,
 }
 
-/// Adam (no weight decay) over every variable of a `VarMap`, with gradient clipping.
-pub struct Trainer {
-    vars: Vec<Var>,
-    optimizer: AdamW,
-    max_grad_norm: Option<f64>,
-}
-
-impl Trainer {
-    pub fn new(varmap: &VarMap, config: &TrainConfig) -> Result<Self> {
-        let vars = varmap.all_vars();
-        // candle's AdamW with zero weight decay is Adam (its default decay is 0.01).
-        let params = ParamsAdamW { lr: config.learning_rate, weight_decay: 0.0, ..Default::default() };
-        let optimizer = AdamW::new(vars.clone(), params)?;
-        Ok(Self { vars, optimizer, max_grad_norm: config.max_grad_norm })
+impl MpnTrainer {
+    /// A freshly initialised network (drawn from `seed`, see [`Mpn::init`]) and fresh moments;
+    /// gradients are clipped to a global norm of `max_grad_norm` if set.
+    pub fn new(config: MpnConfig, seed: u64, max_grad_norm: Option<f64>) -> Result<Self> {
+        let (network, varmap) = Mpn::init(config, seed, DType::F32, &Device::Cpu)?;
+        let optimiser = Adam::new(&varmap, max_grad_norm)?;
+        Ok(Self { network, varmap, optimiser })
     }
 
-    pub fn set_learning_rate(&mut self, lr: f64) {
-        self.optimizer.set_learning_rate(lr);
+    /// The network of a checkpoint written by [`Self::save`], with fresh moments.
+    pub fn load(weights: &Path, max_grad_norm: Option<f64>) -> Result<Self> {
+        let (network, varmap) = Mpn::load_trainable(weights)?;
+        let optimiser = Adam::new(&varmap, max_grad_norm)?;
+        Ok(Self { network, varmap, optimiser })
     }
 
-    /// Backpropagates `loss`, clips and applies one Adam update; returns the gradient norm
-    /// before clipping.
-    pub fn step(&mut self, loss: &Tensor) -> Result<f64> {
-        let mut grads = loss.backward()?;
-        let norm = match self.max_grad_norm {
-            Some(max) => clip_grad_norm(&mut grads, &self.vars, max)?,
-            None => grad_norm(&grads, &self.vars)?,
-        };
-        self.optimizer.step(&grads)?;
-        Ok(norm)
+    /// Restores the moments written by [`Self::save_optimiser`] and the count of updates taken.
+    pub fn load_optimiser(&mut self, path: &Path, steps: u64) -> Result<()> {
+        self.optimiser.load(path, steps).map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })
     }
-}
 
-/// Global L2 norm of the gradients of `vars` (missing gradients count as zero).
-pub fn grad_norm(grads: &GradStore, vars: &[Var]) -> Result<f64> {
-    let mut sum = 0.0;
-    for var in vars {
-        if let Some(g) = grads.get(var) {
-            sum += g.to_dtype(DType::F64)?.sqr()?.sum_all()?.to_scalar::<f64>()?;
-        }
+    /// The network (sharing the trained variables).
+    pub fn network(&self) -> &Mpn {
+        &self.network
     }
-    Ok(sum.sqrt())
-}
 
-/// Scales all gradients by `max_norm / (norm + 1e-6)` when their global norm exceeds `max_norm`
-/// (PyTorch's `clip_grad_norm_`); returns the norm before clipping.
-pub fn clip_grad_norm(grads: &mut GradStore, vars: &[Var], max_norm: f64) -> Result<f64> {
-    let norm = grad_norm(grads, vars)?;
-    let scale = max_norm / (norm + 1e-6);
-    if scale < 1.0 {
-        for var in vars {
-            if let Some(g) = grads.remove(var) {
-                grads.insert(var, (g * scale)?);
-            }
-        }
+    /// Optimiser updates taken so far.
+    pub fn optimiser_steps(&self) -> u64 {
+        self.optimiser.steps()
     }
-    Ok(norm)
-}
 
-/// Mean squared error between predictions and targets of the same shape.
-pub fn mse(prediction: &Tensor, target: &Tensor) -> Result<Tensor> {
-    Ok(candle_nn::loss::mse(prediction, target)?)
+    /// One step on `batch` with one target per node: training-mode forward (edge dropout drawn
+    /// from `rng`), mean squared error, backward, clipping, an Adam update with rate `lr`.
+    pub fn train_step<R: Rng + ?Sized>(
+        &mut self,
+        batch: &GraphBatch,
+        targets: &[f32],
+        lr: f64,
+        rng: &mut R,
+    ) -> Result<StepLoss> {
+        let input = GraphInput::from_batch(batch, DType::F32, &Device::Cpu)?;
+        let output = self.network.forward_train(&input, rng)?;
+        // The mean squared error, kept per node for the caller.
+        let squared_errors = (output - Tensor::from_slice(targets, batch.num_nodes, &Device::Cpu)?)?.sqr()?;
+        let loss = squared_errors.mean_all()?;
+        let squared_errors = squared_errors.to_vec1::<f32>()?;
+        let loss_value = f64::from(loss.to_scalar::<f32>()?);
+        let grad_norm = self.optimiser.step(&loss, lr)?;
+        Ok(StepLoss { loss: loss_value, squared_errors, grad_norm })
+    }
+
+    /// Saves the network as [`Mpn::save`] does.
+    pub fn save(&self, weights: &Path) -> Result<()> {
+        self.network.save(&self.varmap, weights)
+    }
+
+    /// Writes the optimiser's moments (safetensors); the update count is the caller's to store.
+    pub fn save_optimiser(&self, path: &Path) -> Result<()> {
+        self.optimiser.save(path).map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })
+    }
 }

@@ -85,7 +85,7 @@ fn fused_matches_stock_candle(config: MpnConfig) {
     for (a, b) in values(&fast).iter().zip(values(&naive)) {
         assert!((a - b).abs() < 1e-12, "{a} vs {b}");
     }
-    let grads = |out: &Tensor| amber_mpn::mse(out, &target).unwrap().backward().unwrap();
+    let grads = |out: &Tensor| candle_nn::loss::mse(out, &target).unwrap().backward().unwrap();
     let (gf, gn) = (grads(&fast), grads(&naive));
     for var in varmap.all_vars() {
         let (a, b) = (values(gf.get(&var).unwrap()), values(gn.get(&var).unwrap()));
@@ -143,7 +143,7 @@ fn f32_matches_f64() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("model.safetensors");
     m64.save(&vars, &path).unwrap();
-    let m32 = Mpn::load(&path, DType::F32, &Device::Cpu).unwrap();
+    let m32 = Mpn::load(&path).unwrap();
     let (a, b) =
         (values(&m64.forward(&graph(DType::F64, 3)).unwrap()), values(&m32.forward(&graph(DType::F32, 3)).unwrap()));
     for (x, y) in a.iter().zip(&b) {
@@ -205,24 +205,24 @@ fn checkpoints_round_trip_and_reject_wrong_shapes() {
     let g = graph(DType::F32, 6);
     let expected = values(&model.forward(&g).unwrap());
 
-    let plain = Mpn::load(&path, DType::F32, &Device::Cpu).unwrap();
+    let plain = Mpn::load(&path).unwrap();
     assert!(plain.parameters().iter().all(|p| !p.is_variable()));
     let out = plain.forward(&g).unwrap();
     assert!(!out.track_op(), "inference from plain tensors must record no graph");
     assert_eq!(values(&out), expected);
     assert!(!model.for_inference().forward(&g).unwrap().track_op());
-    let (trainable, vars) = Mpn::load_trainable(&path, DType::F32, &Device::Cpu).unwrap();
+    let (trainable, vars) = Mpn::load_trainable(&path).unwrap();
     assert_eq!(values(&trainable.forward(&g).unwrap()), expected);
     assert_eq!(vars.all_vars().len(), model.parameters().len());
 
     // The same weights under a configuration with another width or depth.
     for config in [MpnConfig { latent_dim: 16, ..small_config() }, MpnConfig { steps: 2, ..small_config() }] {
         std::fs::write(path.with_extension("json"), serde_json::to_string(&config).unwrap()).unwrap();
-        assert!(matches!(Mpn::load(&path, DType::F32, &Device::Cpu), Err(MpnError::Checkpoint { .. })));
-        assert!(matches!(Mpn::load_trainable(&path, DType::F32, &Device::Cpu), Err(MpnError::Checkpoint { .. })));
+        assert!(matches!(Mpn::load(&path), Err(MpnError::Checkpoint { .. })));
+        assert!(matches!(Mpn::load_trainable(&path), Err(MpnError::Checkpoint { .. })));
     }
     std::fs::write(path.with_extension("json"), "{\"latent_dim\": ").unwrap();
-    assert!(matches!(Mpn::load(&path, DType::F32, &Device::Cpu), Err(MpnError::Json { .. })));
-    assert!(matches!(Mpn::load(&dir.join("missing.safetensors"), DType::F32, &Device::Cpu), Err(MpnError::Io { .. })));
+    assert!(matches!(Mpn::load(&path), Err(MpnError::Json { .. })));
+    assert!(matches!(Mpn::load(&dir.join("missing.safetensors")), Err(MpnError::Io { .. })));
     std::fs::remove_dir_all(dir).unwrap();
 }

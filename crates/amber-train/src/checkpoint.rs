@@ -19,9 +19,10 @@ use std::path::{Path, PathBuf};
 
 use amber_graph::FeatureSet;
 use amber_mesh::Mesh;
-use candle_core::{Device, Tensor};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use safetensors::tensor::TensorView;
+use safetensors::{Dtype, SafeTensors};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, io_error};
@@ -226,23 +227,52 @@ fn entry_path(entries_dir: &Path, id: u64) -> PathBuf {
     entries_dir.join(format!("{id:010}.safetensors"))
 }
 
-/// Writes one entry's mesh, input columns and labels (safetensors: `vertices`, `cells`,
-/// `labels`, `column.<name>`).
+/// Writes one entry's mesh, input columns and labels (safetensors: `vertices` f64 `(V, D)`,
+/// `cells` u32 `(K, D + 1)`, `labels` f64, `column.<name>` f64).
 fn save_entry<const D: usize>(path: &Path, sample: &Sample<D>) -> Result<()> {
-    let (mesh, cpu) = (&sample.state.mesh, &Device::Cpu);
+    let mesh = &sample.state.mesh;
     let vertices: Vec<f64> = mesh.vertices().iter().flatten().copied().collect();
-    let mut tensors = HashMap::from([
-        ("vertices".to_string(), Tensor::from_vec(vertices, (mesh.num_vertices(), D), cpu)?),
-        ("cells".to_string(), Tensor::from_vec(mesh.cells().to_vec(), (mesh.num_elements(), D + 1), cpu)?),
-        ("labels".to_string(), Tensor::from_slice(&sample.labels, sample.labels.len(), cpu)?),
-    ]);
+    let mut tensors = vec![
+        ("vertices".to_string(), Dtype::F64, vec![mesh.num_vertices(), D], le_bytes(&vertices, f64::to_le_bytes)),
+        ("cells".to_string(), Dtype::U32, vec![mesh.num_elements(), D + 1], le_bytes(mesh.cells(), u32::to_le_bytes)),
+        ("labels".to_string(), Dtype::F64, vec![sample.labels.len()], le_bytes(&sample.labels, f64::to_le_bytes)),
+    ];
     for c in &sample.state.columns {
-        tensors.insert(format!("column.{}", c.name), Tensor::from_slice(&c.values, c.values.len(), cpu)?);
+        tensors.push((
+            format!("column.{}", c.name),
+            Dtype::F64,
+            vec![c.values.len()],
+            le_bytes(&c.values, f64::to_le_bytes),
+        ));
     }
     amber_stdx::write_atomic_via(path, |tmp| {
-        candle_core::safetensors::save(&tensors, tmp)
-            .map_err(|e| TrainError::Checkpoint { path: tmp.into(), message: e.to_string() })
+        let fail =
+            |e: safetensors::SafeTensorError| TrainError::Checkpoint { path: tmp.into(), message: e.to_string() };
+        let views = tensors
+            .iter()
+            .map(|(name, dtype, shape, data)| Ok((name.as_str(), TensorView::new(*dtype, shape.clone(), data)?)))
+            .collect::<Result<Vec<_>, safetensors::SafeTensorError>>()
+            .map_err(fail)?;
+        safetensors::serialize_to_file(views, None, tmp).map_err(fail)
     })
+}
+
+/// The little-endian bytes of `values`, as safetensors stores them.
+fn le_bytes<T: Copy, const N: usize>(values: &[T], to_bytes: impl Fn(T) -> [u8; N]) -> Vec<u8> {
+    values.iter().flat_map(|&v| to_bytes(v)).collect()
+}
+
+/// The values of a stored tensor of `dtype` (any shape, row-major).
+fn le_values<T, const N: usize>(
+    name: &str,
+    view: &TensorView<'_>,
+    dtype: Dtype,
+    from_bytes: impl Fn([u8; N]) -> T,
+) -> Result<Vec<T>, String> {
+    if view.dtype() != dtype {
+        return Err(format!("tensor `{name}` is {:?}, expected {dtype:?}", view.dtype()));
+    }
+    Ok(view.data().chunks_exact(N).map(|b| from_bytes(b.try_into().expect("chunks of N bytes"))).collect())
 }
 
 /// Reads the entry `record` from the checkpoint `dir` and rebuilds its graph and targets.
@@ -254,17 +284,20 @@ pub(crate) fn load_entry<const D: usize>(
 ) -> Result<BufferEntry<D>> {
     let path = entry_path(&dir.parent().unwrap_or(dir).join(ENTRIES_DIR), record.id);
     let fail = |message: String| TrainError::Checkpoint { path: path.clone(), message };
-    let mut tensors = candle_core::safetensors::load(&path, &Device::Cpu).map_err(|e| fail(e.to_string()))?;
+    let bytes = std::fs::read(&path).map_err(io_error(&path))?;
+    let file = SafeTensors::deserialize(&bytes).map_err(|e| fail(e.to_string()))?;
+    let mut tensors: HashMap<String, TensorView<'_>> = file.tensors().into_iter().collect();
     let mut take = |name: &str| tensors.remove(name).ok_or_else(|| fail(format!("missing tensor `{name}`")));
-    let vertices: Vec<f64> = take("vertices")?.flatten_all()?.to_vec1()?;
-    let cells: Vec<u32> = take("cells")?.flatten_all()?.to_vec1()?;
-    let labels: Vec<f64> = take("labels")?.to_vec1()?;
+    let vertices = le_values("vertices", &take("vertices")?, Dtype::F64, f64::from_le_bytes).map_err(fail)?;
+    let cells = le_values("cells", &take("cells")?, Dtype::U32, u32::from_le_bytes).map_err(fail)?;
+    let labels = le_values("labels", &take("labels")?, Dtype::F64, f64::from_le_bytes).map_err(fail)?;
     let vertices = vertices.chunks_exact(D).map(|v| std::array::from_fn(|k| v[k])).collect();
     let mesh = Mesh::new(vertices, cells).map_err(|e| fail(e.to_string()))?;
     let mut columns = Vec::new();
     for (name, t) in tensors {
         let name = name.strip_prefix("column.").ok_or_else(|| fail(format!("unexpected tensor `{name}`")))?;
-        columns.push(Column { name: name.to_string(), values: t.to_vec1()? });
+        let values = le_values(name, &t, Dtype::F64, f64::from_le_bytes).map_err(fail)?;
+        columns.push(Column { name: name.to_string(), values });
     }
     columns.sort_by(|a, b| a.name.cmp(&b.name));
     let state = MeshState::from_columns(features, mesh, columns).map_err(|e| fail(e.to_string()))?;

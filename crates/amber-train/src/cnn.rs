@@ -13,20 +13,18 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use amber_cnn::{CnnLoss, PixelGrid, Raster, UNet, UNetConfig};
+use amber_cnn::{CnnLoss, CnnTrainer, PixelGrid, Raster, TrainingImages, UNet, UNetConfig};
 use amber_graph::{Aggregation, GraphError, NodeFeature, RunningMoments, VARIANCE_EPSILON};
 use amber_mesh::Mesh;
 use amber_meshgen::SizingField;
 use amber_stdx::{read_json, write_json_atomic};
 use amber_tasks::{MeshLimits, Problem, StepOutcome, generation_step, labels};
-use candle_core::{DType, Device, Tensor};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, fingerprints, seeded_stream};
 use crate::error::{Result, TrainError, in_problem, io_error};
-use crate::optim::Adam;
 use crate::{BufferEntry, DataConfig, MeshMetrics, Profile, Reference, Rollout, RolloutStep, StepStatus};
 
 /// File of the U-Net weights (and BatchNorm statistics) inside a CNN model directory.
@@ -259,8 +257,8 @@ fn transpose(data: &[f32], rows: usize, cols: usize) -> Vec<f32> {
 }
 
 impl CnnPredictor {
-    /// The normalised network input of one rasterised problem, `(1, C, r, ..., r)`.
-    fn input<const D: usize>(&self, sample: &Rasterised<D>) -> Result<Tensor> {
+    /// The normalised network input of one rasterised problem, channel-major `C × pixels`.
+    fn input<const D: usize>(&self, sample: &Rasterised<D>) -> Result<Vec<f32>> {
         let (channels, pixels) = (self.network.in_channels, sample.raster.grid.len());
         if sample.channels.len() != channels * pixels {
             return Err(TrainError::InvalidConfig(format!(
@@ -268,22 +266,21 @@ impl CnnPredictor {
                 sample.channels.len() / pixels
             )));
         }
-        let data = match &self.normaliser {
+        Ok(match &self.normaliser {
             Some(moments) => {
                 let mut rows = transpose(&sample.channels, channels, pixels);
                 moments.normalise(&mut rows)?;
                 transpose(&rows, pixels, channels)
             }
             None => sample.channels.clone(),
-        };
-        let shape: Vec<usize> = [1, channels].into_iter().chain(sample.raster.grid.shape).collect();
-        Ok(Tensor::from_vec(data, shape, &Device::Cpu)?)
+        })
     }
 
     /// The predicted size of every auxiliary element: the network's pixel field, outside pixels
     /// filled from inside ones, read at the element midpoints.
     fn predict<const D: usize>(&self, network: &UNet, sample: &Rasterised<D>) -> Result<Vec<f64>> {
-        let z: Vec<f32> = network.forward(&self.input(sample)?)?.flatten_all()?.to_vec1()?;
+        let shape: Vec<usize> = [1, self.network.in_channels].into_iter().chain(sample.raster.grid.shape).collect();
+        let z = network.predict(&self.input(sample)?, &shape)?;
         let (scale, shift) = match &self.label_moments {
             Some(m) => ((m.variance()[0] + VARIANCE_EPSILON).sqrt(), m.mean()[0]),
             None => (1.0, 0.0),
@@ -312,7 +309,7 @@ impl CnnModel {
     /// Loads a model directory written by [`Self::save`] (a checkpoint directory is one too).
     pub fn load(dir: &Path) -> Result<Self> {
         let predictor: CnnPredictor = read_json(&dir.join(CNN_PREDICTOR_FILE))?;
-        let network = UNet::load(predictor.network.clone(), &dir.join(CNN_WEIGHTS_FILE), DType::F32)?;
+        let network = UNet::load(predictor.network.clone(), &dir.join(CNN_WEIGHTS_FILE))?;
         Ok(Self { network, predictor })
     }
 
@@ -415,22 +412,12 @@ struct CnnState {
     problems: Vec<ProblemFingerprint>,
 }
 
-/// The training images of a run, stacked: inputs `(N, C, r, ...)` normalised, targets and
-/// masks `(N, 1, r, ...)`.
-struct TrainingImages {
-    inputs: Tensor,
-    targets: Tensor,
-    masks: Tensor,
-}
-
 /// A CNN training run.
 pub struct CnnTraining<const D: usize, P: Problem<D>> {
     config: CnnConfig,
     problems: Vec<P>,
-    network: UNet,
-    optimiser: Adam,
+    trainer: CnnTrainer,
     predictor: CnnPredictor,
-    images: TrainingImages,
     step: u64,
     subset_rng: ChaCha8Rng,
 }
@@ -504,7 +491,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         let mut normalised = normalised.into_iter();
         let (mut inputs, mut targets, mut masks) = (Vec::new(), Vec::new(), Vec::new());
         for (sample, _) in &samples {
-            inputs.push(predictor.input(sample)?);
+            inputs.extend(predictor.input(sample)?);
             for owner in &sample.raster.owners {
                 targets.push(if owner.is_some() {
                     normalised.next().expect("one target per inside pixel")
@@ -514,30 +501,17 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
                 masks.push(if owner.is_some() { 1.0f32 } else { 0.0 });
             }
         }
-        let label_shape: Vec<usize> = [samples.len(), 1].into_iter().chain(samples[0].0.raster.grid.shape).collect();
-        let images = TrainingImages {
-            inputs: Tensor::cat(&inputs, 0)?,
-            targets: Tensor::from_vec(targets, label_shape.as_slice(), &Device::Cpu)?,
-            masks: Tensor::from_vec(masks, label_shape.as_slice(), &Device::Cpu)?,
-        };
+        let spatial = samples[0].0.raster.grid.shape;
+        let images = TrainingImages::new(inputs, targets, masks, samples.len(), channels, &spatial)?;
         Ok((network(&predictor)?, predictor, images))
     }
 
     /// A fresh run on `problems` with a network initialised from the seed.
     pub fn new(config: CnnConfig, problems: Vec<P>) -> Result<Self> {
         let (network, predictor, images) =
-            Self::prepare(&config, &problems, |p| Ok(UNet::init(p.network.clone(), config.seed, DType::F32)?))?;
-        let optimiser = Adam::new(network.varmap(), config.max_grad_norm)?;
-        Ok(Self {
-            subset_rng: seeded_stream(config.seed, 3),
-            config,
-            problems,
-            network,
-            optimiser,
-            predictor,
-            images,
-            step: 0,
-        })
+            Self::prepare(&config, &problems, |p| Ok(UNet::init(p.network.clone(), config.seed)?))?;
+        let trainer = CnnTrainer::new(network, images, config.loss, config.max_grad_norm)?;
+        Ok(Self { subset_rng: seeded_stream(config.seed, 3), config, problems, trainer, predictor, step: 0 })
     }
 
     /// Resumes the newest checkpoint under `out_dir` if there is one (the configuration and
@@ -560,24 +534,14 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
             return Err(fail("the training problems differ from the checkpointed run's"));
         }
         let saved: CnnPredictor = read_json(&dir.join(CNN_PREDICTOR_FILE))?;
-        let (network, predictor, images) = Self::prepare(&config, &problems, |p| {
-            Ok(UNet::load(p.network.clone(), &dir.join(CNN_WEIGHTS_FILE), DType::F32)?)
-        })?;
+        let (network, predictor, images) =
+            Self::prepare(&config, &problems, |p| Ok(UNet::load(p.network.clone(), &dir.join(CNN_WEIGHTS_FILE))?))?;
         if saved != predictor {
             return Err(fail("the rasterised problems give another normaliser or limits than the checkpointed run's"));
         }
-        let mut optimiser = Adam::new(network.varmap(), config.max_grad_norm)?;
-        optimiser.load(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
-        Ok(Self {
-            subset_rng: state.subset_rng.restore(dir)?,
-            config,
-            problems,
-            network,
-            optimiser,
-            predictor,
-            images,
-            step: state.step,
-        })
+        let mut trainer = CnnTrainer::new(network, images, config.loss, config.max_grad_norm)?;
+        trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
+        Ok(Self { subset_rng: state.subset_rng.restore(dir)?, config, problems, trainer, predictor, step: state.step })
     }
 
     /// The run's configuration.
@@ -597,7 +561,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
 
     /// The network (sharing the trained variables; [`cnn_rollouts`] evaluates it as it stands).
     pub fn network(&self) -> &UNet {
-        &self.network
+        self.trainer.network()
     }
 
     /// The training problems.
@@ -613,26 +577,17 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
             Some(k) if k < total => {
                 let mut picked = rand::seq::index::sample(&mut self.subset_rng, total, k).into_vec();
                 picked.sort_unstable();
-                Some(Tensor::from_vec(picked.into_iter().map(|i| i as u32).collect::<Vec<_>>(), k, &Device::Cpu)?)
+                Some(picked)
             }
             _ => None,
         };
-        let pick = |t: &Tensor| match &chosen {
-            Some(index) => t.index_select(index, 0),
-            None => Ok(t.clone()),
-        };
-        let (inputs, targets, masks) =
-            (pick(&self.images.inputs)?, pick(&self.images.targets)?, pick(&self.images.masks)?);
-        let output = self.network.forward_train(&inputs)?;
-        let loss = self.config.loss.loss(&output, &targets, &masks)?;
-        let loss_value = f64::from(loss.to_scalar::<f32>()?);
-        let grad_norm = self.optimiser.step(&loss, self.config.learning_rate)?;
+        let step = self.trainer.train_step(chosen.as_deref(), self.config.learning_rate)?;
         self.step += 1;
         Ok(CnnStepReport {
             step: self.step,
-            loss: loss_value,
-            grad_norm,
-            images: inputs.dim(0)?,
+            loss: step.loss,
+            grad_norm: step.grad_norm,
+            images: step.images,
             seconds: started.elapsed().as_secs_f64(),
         })
     }
@@ -658,7 +613,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
 
     /// Writes the current model to `dir`.
     pub fn save_model(&self, dir: &Path) -> Result<()> {
-        CnnModel::save(&self.network, &self.predictor, dir)
+        CnnModel::save(self.trainer.network(), &self.predictor, dir)
     }
 
     /// Writes a checkpoint of the current state under `out_dir/checkpoints`; returns its
@@ -667,13 +622,13 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         let state = CnnState {
             config: self.config.clone(),
             step: self.step,
-            optimiser_steps: self.optimiser.steps(),
+            optimiser_steps: self.trainer.optimiser_steps(),
             subset_rng: RngState::of(&self.subset_rng),
             problems: fingerprints(&self.problems),
         };
         checkpoint::commit(out_dir, self.step, std::iter::empty::<&BufferEntry<D>>(), |dir| {
             self.save_model(dir)?;
-            self.optimiser.save(&dir.join(OPTIMISER_FILE))?;
+            self.trainer.save_optimiser(&dir.join(OPTIMISER_FILE))?;
             Ok(write_json_atomic(&dir.join(STATE_FILE), &state)?)
         })
     }

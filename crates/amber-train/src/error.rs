@@ -39,12 +39,6 @@ pub enum TrainError {
     Checkpoint { path: PathBuf, message: String },
 }
 
-impl From<candle_core::Error> for TrainError {
-    fn from(e: candle_core::Error) -> Self {
-        TrainError::Network(MpnError::Candle(e))
-    }
-}
-
 impl From<amber_stdx::FileError> for TrainError {
     fn from(e: amber_stdx::FileError) -> Self {
         match e {

@@ -19,7 +19,6 @@ mod config;
 mod error;
 mod inference;
 mod model;
-mod optim;
 mod target;
 mod train;
 
@@ -35,6 +34,5 @@ pub use inference::{
     Evaluation, EvaluationSummary, MeshMetrics, Reference, Rollout, RolloutStep, StepStatus, StepSummary, rollouts,
 };
 pub use model::{AmberModel, Predictor, WEIGHTS_FILE};
-pub use optim::Adam;
 pub use target::{TargetTransform, softplus, softplus_inverse};
 pub use train::{Addition, CONFIG_FILE, LOG_FILE, MODEL_DIR, StepReport, Training, TrainingObserver};

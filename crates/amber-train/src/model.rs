@@ -4,9 +4,8 @@
 use std::path::Path;
 
 use amber_graph::{FeatureNormaliser, FeatureSet, GraphBatch};
-use amber_mpn::{GraphInput, Mpn};
+use amber_mpn::{Mpn, MpnTrainer};
 use amber_stdx::{read_json, write_json_atomic};
-use candle_core::{DType, Device};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, io_error};
@@ -41,8 +40,7 @@ impl Predictor {
         if let Some(normaliser) = &self.normaliser {
             normaliser.normalise(&mut batch)?;
         }
-        let input = GraphInput::from_batch(&batch, network.dtype(), &Device::Cpu)?;
-        let z: Vec<f32> = network.for_inference().forward(&input)?.to_dtype(DType::F32)?.to_vec1()?;
+        let z = network.predict(&batch)?;
         Ok(states
             .iter()
             .zip(batch.node_offsets.windows(2))
@@ -59,17 +57,17 @@ pub struct AmberModel {
 
 impl AmberModel {
     /// Writes `model.safetensors`, `model.json` and `predictor.json` into `dir` (created if
-    /// missing). `varmap` holds the network's variables.
-    pub fn save(network: &Mpn, varmap: &candle_nn::VarMap, predictor: &Predictor, dir: &Path) -> Result<()> {
+    /// missing).
+    pub fn save(trainer: &MpnTrainer, predictor: &Predictor, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(io_error(dir))?;
-        network.save(varmap, &dir.join(WEIGHTS_FILE))?;
+        trainer.save(&dir.join(WEIGHTS_FILE))?;
         Ok(write_json_atomic(&dir.join(PREDICTOR_FILE), predictor)?)
     }
 
     /// Loads a model directory written by [`Self::save`] (a training checkpoint directory is
     /// one too) for inference.
     pub fn load(dir: &Path) -> Result<Self> {
-        let network = Mpn::load(&dir.join(WEIGHTS_FILE), DType::F32, &Device::Cpu)?;
+        let network = Mpn::load(&dir.join(WEIGHTS_FILE))?;
         let predictor = read_json(&dir.join(PREDICTOR_FILE))?;
         Ok(Self { network, predictor })
     }

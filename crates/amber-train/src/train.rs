@@ -8,13 +8,11 @@ use std::time::Instant;
 
 use amber_graph::{FeatureNormaliser, GraphBatch};
 use amber_mesh::Mesh;
-use amber_mpn::{GraphInput, Mpn, MpnConfig};
+use amber_mpn::{Mpn, MpnConfig, MpnTrainer};
 use amber_stdx::{read_json, write_json_atomic};
 use amber_tasks::{
     LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step, labels, with_inputs,
 };
-use candle_core::{DType, Device, Tensor};
-use candle_nn::VarMap;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -24,7 +22,6 @@ use crate::checkpoint::{
 };
 use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::model::WEIGHTS_FILE;
-use crate::optim::Adam;
 use crate::{
     AmberModel, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, TargetTransform, TrainingConfig,
 };
@@ -91,9 +88,7 @@ impl TrainingObserver for () {}
 pub struct Training<const D: usize, P: Problem<D>> {
     config: TrainingConfig,
     problems: Vec<P>,
-    network: Mpn,
-    varmap: VarMap,
-    optimiser: Adam,
+    trainer: MpnTrainer,
     predictor: Predictor,
     buffer: ReplayBuffer<D>,
     step: u64,
@@ -134,16 +129,13 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             output: target.network_output(),
             graph_context: config.network.graph_context,
         };
-        let (network, varmap) = Mpn::init(network_config, config.seed, DType::F32, &Device::Cpu)?;
-        let optimiser = Adam::new(&varmap, config.max_grad_norm)?;
+        let trainer = MpnTrainer::new(network_config, config.seed, config.max_grad_norm)?;
         let mut training = Self {
             buffer: ReplayBuffer::new(config.buffer_capacity),
             dropout_rng: seeded_stream(config.seed, 1),
             buffer_rng: seeded_stream(config.seed, 2),
             config,
-            network,
-            varmap,
-            optimiser,
+            trainer,
             predictor: Predictor { features, normaliser, target, limits },
             step: 0,
             additions: AdditionCounts::default(),
@@ -183,9 +175,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         }
         state.check(problems.len()).map_err(fail)?;
         let predictor: Predictor = read_json(&dir.join(crate::model::PREDICTOR_FILE))?;
-        let (network, varmap) = Mpn::load_trainable(&dir.join(WEIGHTS_FILE), DType::F32, &Device::Cpu)?;
-        let mut optimiser = Adam::new(&varmap, config.max_grad_norm)?;
-        optimiser.load(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
+        let mut trainer = MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.max_grad_norm)?;
+        trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
             records.par_iter().map(|r| checkpoint::load_entry(dir, r, &predictor.features, &predictor.target)).collect()
         };
@@ -200,9 +191,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             buffer_rng: state.buffer_rng.restore(dir)?,
             config,
             problems,
-            network,
-            varmap,
-            optimiser,
+            trainer,
             predictor,
             buffer,
             step: state.step,
@@ -237,7 +226,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
 
     /// The network (sharing the trained variables).
     pub fn network(&self) -> &Mpn {
-        &self.network
+        self.trainer.network()
     }
 
     /// Normalisers, target transform and limits.
@@ -280,27 +269,19 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let targets: Vec<f32> =
             entries.iter().flat_map(|e| self.predictor.target.training_targets(&e.sample.targets)).collect();
         let nodes = batch.num_nodes;
-        let input = GraphInput::from_batch(&batch, DType::F32, &Device::Cpu)?;
-        let output = self.network.forward_train(&input, &mut self.dropout_rng)?;
-        // The mean squared error, kept per node once for the loss by depth.
-        let squared_errors = (output - Tensor::from_vec(targets, nodes, &Device::Cpu)?)?.sqr()?;
-        let loss = squared_errors.mean_all()?;
-        let loss_by_depth = loss_by_depth(
-            &squared_errors.to_vec1::<f32>()?,
-            entries.iter().map(|e| (e.depth, e.sample.state.graph.num_nodes())),
-        );
-        let loss_value = f64::from(loss.to_scalar::<f32>()?);
-        let grad_norm = self.optimiser.step(&loss, lr)?;
+        let step = self.trainer.train_step(&batch, &targets, lr, &mut self.dropout_rng)?;
+        let loss_by_depth =
+            loss_by_depth(&step.squared_errors, entries.iter().map(|e| (e.depth, e.sample.state.graph.num_nodes())));
         let step_seconds = started.elapsed().as_secs_f64();
         let addition =
             if self.step.is_multiple_of(self.config.add_interval) { Some(self.add_generated()?) } else { None };
         self.step += 1;
         Ok(StepReport {
             step: self.step,
-            loss: loss_value,
+            loss: step.loss,
             loss_by_depth,
             learning_rate: lr,
-            grad_norm,
+            grad_norm: step.grad_norm,
             graphs: chosen.len(),
             nodes,
             nodes_per_s: nodes as f64 / step_seconds,
@@ -320,7 +301,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             .expect("protected depth-0 entries are always eligible");
         let entry = self.buffer.get(source);
         let (problem, depth) = (entry.problem, entry.depth + 1);
-        let sizes = self.predictor.predict(&self.network, &[&entry.sample.state])?.pop().expect("one state");
+        let sizes = self.predictor.predict(self.trainer.network(), &[&entry.sample.state])?.pop().expect("one state");
         let outcome = generation_step(&self.problems[problem], &entry.sample.state.mesh, sizes, &self.predictor.limits);
         Ok(match outcome {
             StepOutcome::Meshed(mesh) => {
@@ -380,12 +361,12 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
 
     /// Rolls out the current model on `validation` (evaluation mode) and summarises.
     pub fn validate(&self, validation: &Evaluation<'_, D, P>) -> Result<EvaluationSummary> {
-        Ok(validation.run(&self.network, &self.predictor, self.config.inference_steps)?.1)
+        Ok(validation.run(self.trainer.network(), &self.predictor, self.config.inference_steps)?.1)
     }
 
     /// Writes the current model (network, normalisers, target transform, limits) to `dir`.
     pub fn save_model(&self, dir: &Path) -> Result<()> {
-        AmberModel::save(&self.network, &self.varmap, &self.predictor, dir)
+        AmberModel::save(&self.trainer, &self.predictor, dir)
     }
 
     /// Writes a checkpoint of the current state under `out_dir/checkpoints`; returns its
@@ -396,7 +377,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let state = TrainingState {
             config: self.config.clone(),
             step: self.step,
-            optimiser_steps: self.optimiser.steps(),
+            optimiser_steps: self.trainer.optimiser_steps(),
             dropout_rng: RngState::of(&self.dropout_rng),
             buffer_rng: RngState::of(&self.buffer_rng),
             problems: fingerprints(&self.problems),
@@ -407,7 +388,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         };
         checkpoint::commit(out_dir, self.step, self.buffer.entries(), |dir| {
             self.save_model(dir)?;
-            self.optimiser.save(&dir.join(OPTIMISER_FILE))?;
+            self.trainer.save_optimiser(&dir.join(OPTIMISER_FILE))?;
             Ok(write_json_atomic(&dir.join(STATE_FILE), &state)?)
         })
     }

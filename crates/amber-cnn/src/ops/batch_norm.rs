@@ -4,11 +4,11 @@
 //! includes their dependence on x; in evaluation they are the running statistics, constants.
 //! Channel sums are accumulated in f64.
 
-use candle_core::backend::BackendStorage;
-use candle_core::{CpuStorage, CustomOp3, DType, Layout, Result, Shape, Tensor, bail};
+use amber_nn::op::{Fused, SliceOp, with_slice};
+use candle_core::{DType, Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Float, build_by_planes, cpu_slice, float_dtype, with_slice};
+use super::{Float, build_by_planes};
 
 /// Added to the variance (PyTorch's default).
 pub const EPSILON: f64 = 1e-5;
@@ -68,7 +68,7 @@ pub fn batch_norm_relu(
         mean: normalising.mean,
         batch_statistics: running.is_none(),
     };
-    Ok((x.apply_op3(&gamma.contiguous()?, &beta.contiguous()?, op)?, reported))
+    Ok((x.apply_op3(&gamma.contiguous()?, &beta.contiguous()?, Fused(op))?, reported))
 }
 
 /// Mean and biased variance of every channel of `(N, C, plane)` data.
@@ -95,7 +95,7 @@ struct BatchNormRelu {
 }
 
 impl BatchNormRelu {
-    fn forward<T: Float>(&self, x: &[T], gamma: &[T], beta: &[T], plane: usize) -> Vec<T> {
+    fn normalise<T: Float>(&self, x: &[T], gamma: &[T], beta: &[T], plane: usize) -> Vec<T> {
         let channels = self.mean.len();
         build_by_planes(x.len(), plane, |i, y| {
             let c = i % channels;
@@ -109,7 +109,7 @@ impl BatchNormRelu {
     }
 
     /// Gradients of x, γ and β from the output `y` (its sign is the ReLU mask) and `dy`.
-    fn backward<T: Float>(&self, x: &[T], gamma: &[T], y: &[T], dy: &[T], plane: usize) -> (Vec<T>, Vec<T>, Vec<T>) {
+    fn gradients<T: Float>(&self, x: &[T], gamma: &[T], y: &[T], dy: &[T], plane: usize) -> (Vec<T>, Vec<T>, Vec<T>) {
         let channels = self.mean.len();
         let images = x.len() / (channels * plane).max(1);
         // Σ g and Σ g·x̂ per channel, g = dy where the ReLU passed.
@@ -152,65 +152,25 @@ impl BatchNormRelu {
     }
 }
 
-impl CustomOp3 for BatchNormRelu {
-    fn name(&self) -> &'static str {
-        "amber-batch-norm-relu"
-    }
+impl<T: Float> SliceOp<T, 3> for BatchNormRelu {
+    const NAME: &'static str = "amber-batch-norm-relu";
 
-    fn cpu_fwd(
-        &self,
-        xs: &CpuStorage,
-        xl: &Layout,
-        gs: &CpuStorage,
-        gl: &Layout,
-        bs: &CpuStorage,
-        bl: &Layout,
-    ) -> Result<(CpuStorage, Shape)> {
+    fn forward(&self, [x, gamma, beta]: [&[T]; 3], [xl, ..]: [&Layout; 3]) -> Result<(Vec<T>, Shape)> {
         let plane = xl.dims()[2..].iter().product();
-        let storage = match float_dtype(self.name(), &[xs.dtype(), gs.dtype(), bs.dtype()])? {
-            DType::F32 => {
-                CpuStorage::F32(self.forward::<f32>(cpu_slice(xs, xl)?, cpu_slice(gs, gl)?, cpu_slice(bs, bl)?, plane))
-            }
-            _ => {
-                CpuStorage::F64(self.forward::<f64>(cpu_slice(xs, xl)?, cpu_slice(gs, gl)?, cpu_slice(bs, bl)?, plane))
-            }
-        };
-        Ok((storage, xl.shape().clone()))
+        Ok((self.normalise(x, gamma, beta, plane), xl.shape().clone()))
     }
 
-    fn bwd(
+    fn backward(
         &self,
-        x: &Tensor,
-        gamma: &Tensor,
-        beta: &Tensor,
-        res: &Tensor,
-        grad: &Tensor,
-    ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-        match float_dtype(self.name(), &[x.dtype(), gamma.dtype(), grad.dtype()])? {
-            DType::F32 => self.run_backward::<f32>(x, gamma, beta, res, grad),
-            _ => self.run_backward::<f64>(x, gamma, beta, res, grad),
-        }
-    }
-}
-
-impl BatchNormRelu {
-    fn run_backward<T: Float>(
-        &self,
-        x: &Tensor,
-        gamma: &Tensor,
-        beta: &Tensor,
-        y: &Tensor,
-        dy: &Tensor,
-    ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-        let plane = x.dims()[2..].iter().product();
-        let (dx, dgamma, dbeta) = with_slice::<T, _>(x, |xv| {
-            with_slice(gamma, |g| with_slice(y, |yv| with_slice(dy, |d| Ok(self.backward(xv, g, yv, d, plane)))))
-        })?;
-        Ok((
-            Some(Tensor::from_vec(dx, x.shape(), x.device())?),
-            Some(Tensor::from_vec(dgamma, gamma.shape(), gamma.device())?),
-            Some(Tensor::from_vec(dbeta, beta.shape(), beta.device())?),
-        ))
+        [x, gamma, _]: [&[T]; 3],
+        [xl, ..]: [&Layout; 3],
+        y: &[T],
+        dy: &[T],
+        _: [bool; 3],
+    ) -> Result<[Option<Vec<T>>; 3]> {
+        let plane = xl.dims()[2..].iter().product();
+        let (dx, dgamma, dbeta) = self.gradients(x, gamma, y, dy, plane);
+        Ok([Some(dx), Some(dgamma), Some(dbeta)])
     }
 }
 
@@ -258,9 +218,13 @@ mod tests {
 
     #[test]
     fn gradient_matches_finite_differences_in_both_modes() {
-        check_finite_differences(&inputs(DType::F64), &|t| Ok(batch_norm_relu(&t[0], &t[1], &t[2], None)?.0));
+        check_finite_differences(&inputs(DType::F64), &|t| {
+            probe_loss(&batch_norm_relu(&t[0], &t[1], &t[2], None)?.0, 99)
+        });
         let running = BatchNormStats { mean: vec![0.1, -0.2, 0.0, 0.3], variance: vec![0.5, 1.0, 2.0, 0.25] };
-        check_finite_differences(&inputs(DType::F64), &|t| Ok(batch_norm_relu(&t[0], &t[1], &t[2], Some(&running))?.0));
+        check_finite_differences(&inputs(DType::F64), &|t| {
+            probe_loss(&batch_norm_relu(&t[0], &t[1], &t[2], Some(&running))?.0, 99)
+        });
     }
 
     #[test]

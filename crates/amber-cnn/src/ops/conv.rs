@@ -6,11 +6,11 @@
 //! same convolution of the output gradient with the flipped, transposed kernel; the weight
 //! gradient is `Σ dY_tile · colsᵀ` accumulated per thread.
 
-use candle_core::backend::BackendStorage;
-use candle_core::{CpuStorage, CustomOp2, DType, Layout, Result, Shape, Tensor, bail};
+use amber_nn::op::{Fused, SliceOp};
+use candle_core::{Layout, Result, Shape, Tensor, bail};
 
 use super::gemm::{Strided, for_each_item, matmul, sum_over_items};
-use super::{Float, SharedMut, cpu_slice, float_dtype, image_dims, with_slice};
+use super::{Float, SharedMut, image_dims};
 
 /// Scratch elements of one im2col tile (2 MB in f32): big enough for efficient products, small
 /// enough to stay in cache between the unfold and the product.
@@ -24,7 +24,7 @@ pub fn conv(x: &Tensor, w: &Tensor) -> Result<Tensor> {
     if x.dim(1)? != c {
         bail!("conv: input has {} channels, the kernel {c} (kernel shape {:?})", x.dim(1)?, w.dims());
     }
-    x.contiguous()?.apply_op2(&w.contiguous()?, Conv { kernel })
+    x.contiguous()?.apply_op2(&w.contiguous()?, Fused(Conv { kernel }))
 }
 
 /// `(O, C, k)` of a kernel tensor `(O, C, k, ..., k)` with `spatial_axes` equal odd sizes k.
@@ -220,56 +220,35 @@ impl Conv {
     }
 }
 
-impl CustomOp2 for Conv {
-    fn name(&self) -> &'static str {
-        "amber-conv"
-    }
+impl<T: Float> SliceOp<T, 2> for Conv {
+    const NAME: &'static str = "amber-conv";
 
-    fn cpu_fwd(&self, xs: &CpuStorage, xl: &Layout, ws: &CpuStorage, wl: &Layout) -> Result<(CpuStorage, Shape)> {
+    fn forward(&self, [x, w]: [&[T]; 2], [xl, wl]: [&Layout; 2]) -> Result<(Vec<T>, Shape)> {
         let (n, c, o, unfold) = self.shapes(xl, wl)?;
         let mut dims = xl.dims().to_vec();
         dims[1] = o;
-        let storage = match float_dtype(self.name(), &[xs.dtype(), ws.dtype()])? {
-            DType::F32 => CpuStorage::F32(forward::<f32>(cpu_slice(xs, xl)?, cpu_slice(ws, wl)?, n, c, o, &unfold)),
-            _ => CpuStorage::F64(forward::<f64>(cpu_slice(xs, xl)?, cpu_slice(ws, wl)?, n, c, o, &unfold)),
-        };
-        Ok((storage, Shape::from(dims)))
+        Ok((forward(x, w, n, c, o, &unfold), Shape::from(dims)))
     }
 
-    fn bwd(&self, x: &Tensor, w: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<(Option<Tensor>, Option<Tensor>)> {
-        let (n, c, o, unfold) = self.shapes(x.layout(), w.layout())?;
-        match float_dtype(self.name(), &[x.dtype(), w.dtype(), grad.dtype()])? {
-            DType::F32 => self.backward::<f32>(x, w, grad, (n, c, o), &unfold),
-            _ => self.backward::<f64>(x, w, grad, (n, c, o), &unfold),
-        }
-    }
-}
-
-impl Conv {
-    fn backward<T: Float>(
+    fn backward(
         &self,
-        x: &Tensor,
-        w: &Tensor,
-        grad: &Tensor,
-        (n, c, o): (usize, usize, usize),
-        unfold: &Unfold,
-    ) -> Result<(Option<Tensor>, Option<Tensor>)> {
-        with_slice::<T, _>(grad, |dy| {
-            // The network's input image needs no gradient: skip the most expensive product.
-            let dx = if x.track_op() {
-                let flipped = with_slice::<T, _>(w, |w| Ok(flip_transpose(w, o, c, unfold.taps())))?;
-                Some(Tensor::from_vec(forward(dy, &flipped, n, o, c, unfold), x.shape(), x.device())?)
-            } else {
-                None
-            };
-            let dw = with_slice::<T, _>(x, |x| Ok(weight_grad(x, dy, n, c, o, unfold)))?;
-            Ok((dx, Some(Tensor::from_vec(dw, w.shape(), w.device())?)))
-        })
+        [x, w]: [&[T]; 2],
+        [xl, wl]: [&Layout; 2],
+        _: &[T],
+        dy: &[T],
+        [x_tracked, _]: [bool; 2],
+    ) -> Result<[Option<Vec<T>>; 2]> {
+        let (n, c, o, unfold) = self.shapes(xl, wl)?;
+        // The network's input image needs no gradient: skip the most expensive product.
+        let dx = x_tracked.then(|| forward(dy, &flip_transpose(w, o, c, unfold.taps()), n, o, c, &unfold));
+        Ok([dx, Some(weight_grad(x, dy, n, c, o, &unfold))])
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use candle_core::DType;
+
     use super::*;
     use crate::ops::testing::*;
 
@@ -357,7 +336,7 @@ mod tests {
     fn gradient_matches_finite_differences() {
         let x = Image::random(1, 2, &[3, 4, 2], 7).tensor(DType::F64);
         let w = tensor(&random_vec(3 * 2 * 27, 8), &[3, 2, 3, 3, 3], DType::F64);
-        check_finite_differences(&[x, w], &|t| conv(&t[0], &t[1]));
+        check_finite_differences(&[x, w], &|t| probe_loss(&conv(&t[0], &t[1])?, 99));
     }
 
     #[test]

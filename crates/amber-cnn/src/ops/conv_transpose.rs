@@ -2,12 +2,12 @@
 //! up-sampling), with bias. Each input position owns its own 2ᴰ output block, so the op is a
 //! product `Z (O·2ᴰ × P) = Wᵀ · X` plus a scatter of Z's rows into the blocks.
 
-use candle_core::backend::BackendStorage;
-use candle_core::{CpuStorage, CustomOp3, DType, Layout, Result, Shape, Tensor, bail};
+use amber_nn::op::{Fused, SliceOp};
+use candle_core::{Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
 use super::gemm::{Strided, matmul, sum_over_items};
-use super::{Float, SharedMut, cpu_slice, float_dtype, image_dims, with_slice};
+use super::{Float, SharedMut, image_dims};
 
 /// Scratch elements of one tile of Z.
 const TILE_ELEMENTS: usize = 1 << 18;
@@ -15,7 +15,7 @@ const TILE_ELEMENTS: usize = 1 << 18;
 /// `x (N, C, spatial...)` with `w (C, O, 2, ..., 2)` and `b (O)` → `(N, O, 2·spatial...)`:
 /// `y[n, o, 2i + a] = b[o] + Σ_c x[n, c, i] · w[c, o, a]`.
 pub fn conv_transpose2(x: &Tensor, w: &Tensor, b: &Tensor) -> Result<Tensor> {
-    x.contiguous()?.apply_op3(&w.contiguous()?, &b.contiguous()?, ConvTranspose2)
+    x.contiguous()?.apply_op3(&w.contiguous()?, &b.contiguous()?, Fused(ConvTranspose2))
 }
 
 struct ConvTranspose2;
@@ -152,63 +152,33 @@ fn backward<T: Float>(x: &[T], w: &[T], dy: &[T], blocks: &Blocks, want_dx: bool
     (dx, dw, db)
 }
 
-impl CustomOp3 for ConvTranspose2 {
-    fn name(&self) -> &'static str {
-        "amber-conv-transpose2"
-    }
+impl<T: Float> SliceOp<T, 3> for ConvTranspose2 {
+    const NAME: &'static str = "amber-conv-transpose2";
 
-    fn cpu_fwd(
-        &self,
-        xs: &CpuStorage,
-        xl: &Layout,
-        ws: &CpuStorage,
-        wl: &Layout,
-        bs: &CpuStorage,
-        bl: &Layout,
-    ) -> Result<(CpuStorage, Shape)> {
+    fn forward(&self, [x, w, b]: [&[T]; 3], [xl, wl, bl]: [&Layout; 3]) -> Result<(Vec<T>, Shape)> {
         let blocks = Blocks::new(xl.dims(), wl.dims(), bl.dims())?;
         let dims: Vec<usize> = [blocks.n, blocks.o].into_iter().chain(xl.dims()[2..].iter().map(|s| 2 * s)).collect();
-        let storage = match float_dtype(self.name(), &[xs.dtype(), ws.dtype(), bs.dtype()])? {
-            DType::F32 => {
-                CpuStorage::F32(forward::<f32>(cpu_slice(xs, xl)?, cpu_slice(ws, wl)?, cpu_slice(bs, bl)?, &blocks))
-            }
-            _ => CpuStorage::F64(forward::<f64>(cpu_slice(xs, xl)?, cpu_slice(ws, wl)?, cpu_slice(bs, bl)?, &blocks)),
-        };
-        Ok((storage, Shape::from(dims)))
+        Ok((forward(x, w, b, &blocks), Shape::from(dims)))
     }
 
-    fn bwd(
+    fn backward(
         &self,
-        x: &Tensor,
-        w: &Tensor,
-        b: &Tensor,
-        _res: &Tensor,
-        grad: &Tensor,
-    ) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-        let blocks = Blocks::new(x.dims(), w.dims(), b.dims())?;
-        match float_dtype(self.name(), &[x.dtype(), w.dtype(), grad.dtype()])? {
-            DType::F32 => run_backward::<f32>(x, w, b, grad, &blocks),
-            _ => run_backward::<f64>(x, w, b, grad, &blocks),
-        }
+        [x, w, _]: [&[T]; 3],
+        [xl, wl, bl]: [&Layout; 3],
+        _: &[T],
+        dy: &[T],
+        [x_tracked, ..]: [bool; 3],
+    ) -> Result<[Option<Vec<T>>; 3]> {
+        let blocks = Blocks::new(xl.dims(), wl.dims(), bl.dims())?;
+        let (dx, dw, db) = backward(x, w, dy, &blocks, x_tracked);
+        Ok([dx, Some(dw), Some(db)])
     }
-}
-
-fn run_backward<T: Float>(
-    x: &Tensor,
-    w: &Tensor,
-    b: &Tensor,
-    grad: &Tensor,
-    blocks: &Blocks,
-) -> Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
-    let (dx, dw, db) = with_slice(x, |xv| {
-        with_slice(w, |wv| with_slice(grad, |g| Ok(backward::<T>(xv, wv, g, blocks, x.track_op()))))
-    })?;
-    let dx = dx.map(|dx| Tensor::from_vec(dx, x.shape(), x.device())).transpose()?;
-    Ok((dx, Some(Tensor::from_vec(dw, w.shape(), w.device())?), Some(Tensor::from_vec(db, b.shape(), b.device())?)))
 }
 
 #[cfg(test)]
 mod tests {
+    use candle_core::DType;
+
     use super::*;
     use crate::ops::testing::*;
 
@@ -275,7 +245,7 @@ mod tests {
         let x = Image::random(1, 2, &[2, 3, 2], 4).tensor(DType::F64);
         let w = tensor(&random_vec(2 * 3 * 8, 5), &[2, 3, 2, 2, 2], DType::F64);
         let b = tensor(&random_vec(3, 6), &[3], DType::F64);
-        check_finite_differences(&[x, w, b], &|t| conv_transpose2(&t[0], &t[1], &t[2]));
+        check_finite_differences(&[x, w, b], &|t| probe_loss(&conv_transpose2(&t[0], &t[1], &t[2])?, 99));
     }
 
     #[test]

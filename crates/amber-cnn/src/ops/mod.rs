@@ -4,7 +4,8 @@
 //! [`max_pool2`] (candle's `max_pool2d` backward is wrong) and [`batch_norm_relu`] (candle-nn's
 //! norms are not all differentiable, and fusing the ReLU saves two passes).
 //!
-//! Tensors are channel-major, `(N, C, spatial...)`. The convolutions are tiled im2col + gemm:
+//! Each is a slice-loop kernel made a candle op by `amber_nn::op::Fused`. Tensors are
+//! channel-major, `(N, C, spatial...)`. The convolutions are tiled im2col + gemm:
 //! each work item unfolds a block of rows of one image into a small scratch matrix and
 //! multiplies it straight into the output, so no image-sized unfolded copy ever exists.
 
@@ -21,7 +22,7 @@ pub use pool::max_pool2;
 
 use std::mem::MaybeUninit;
 
-use candle_core::{CpuStorage, DType, Layout, Result, Storage, Tensor, WithDType, bail};
+use candle_core::{Result, WithDType, bail};
 use rayon::prelude::*;
 
 /// The float types the ops run on: f32 for training, f64 for gradient checks.
@@ -29,37 +30,6 @@ pub(crate) trait Float: WithDType {}
 
 impl Float for f32 {}
 impl Float for f64 {}
-
-/// The contiguous data of a CPU storage.
-fn cpu_slice<'a, T: Float>(s: &'a CpuStorage, l: &Layout) -> Result<&'a [T]> {
-    match l.contiguous_offsets() {
-        Some((start, end)) => Ok(&s.as_slice::<T>()?[start..end]),
-        None => bail!("amber-cnn ops need contiguous inputs"),
-    }
-}
-
-/// The contiguous data of a tensor's storage.
-fn storage_slice<'a, T: Float>(storage: &'a Storage, l: &Layout) -> Result<&'a [T]> {
-    match storage {
-        Storage::Cpu(s) => cpu_slice(s, l),
-        _ => bail!("amber-cnn ops run on the CPU only"),
-    }
-}
-
-/// Runs `f` on the contiguous data of `t`.
-fn with_slice<T: Float, R>(t: &Tensor, f: impl FnOnce(&[T]) -> Result<R>) -> Result<R> {
-    let t = t.contiguous()?;
-    let (storage, layout) = t.storage_and_layout();
-    f(storage_slice(&storage, layout)?)
-}
-
-/// The common float dtype of an op's inputs.
-fn float_dtype(op: &str, dtypes: &[DType]) -> Result<DType> {
-    match dtypes {
-        [first, rest @ ..] if matches!(first, DType::F32 | DType::F64) && rest.iter().all(|d| d == first) => Ok(*first),
-        _ => bail!("{op}: inputs must be all f32 or all f64, got {dtypes:?}"),
-    }
-}
 
 /// `(N, C, spatial...)` of a channel-major tensor with `spatial_axes` spatial axes.
 fn image_dims(op: &str, dims: &[usize], spatial_axes: usize) -> Result<(usize, usize, Vec<usize>)> {

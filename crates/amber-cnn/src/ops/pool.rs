@@ -2,15 +2,15 @@
 //! dropped, as in PyTorch). The backward routes each output gradient to the first maximum of its
 //! window, found again by comparing the input with the stored result.
 
-use candle_core::backend::BackendStorage;
-use candle_core::{CpuStorage, CustomOp1, DType, Layout, Result, Shape, Tensor, bail};
+use amber_nn::op::{Fused, SliceOp};
+use candle_core::{Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Float, build_by_planes, cpu_slice, float_dtype, image_dims, with_slice};
+use super::{Float, build_by_planes, image_dims};
 
 /// `x (N, C, spatial...)` → `(N, C, spatial/2...)`, the maximum of every 2×…×2 window.
 pub fn max_pool2(x: &Tensor) -> Result<Tensor> {
-    x.contiguous()?.apply_op1(MaxPool2)
+    x.contiguous()?.apply_op1(Fused(MaxPool2))
 }
 
 struct MaxPool2;
@@ -101,44 +101,37 @@ fn backward<T: Float>(x: &[T], y: &[T], dy: &[T], windows: &Windows) -> Vec<T> {
     dx
 }
 
-impl MaxPool2 {
-    fn windows(&self, dims: &[usize]) -> Result<Windows> {
-        let (_, _, spatial) = image_dims(self.name(), dims, dims.len().saturating_sub(2))?;
-        Windows::new(&spatial)
-    }
+/// The windows of a `(N, C, spatial...)` input.
+fn windows(dims: &[usize]) -> Result<Windows> {
+    let (_, _, spatial) = image_dims("amber-max-pool2", dims, dims.len().saturating_sub(2))?;
+    Windows::new(&spatial)
 }
 
-impl CustomOp1 for MaxPool2 {
-    fn name(&self) -> &'static str {
-        "amber-max-pool2"
-    }
+impl<T: Float> SliceOp<T, 1> for MaxPool2 {
+    const NAME: &'static str = "amber-max-pool2";
 
-    fn cpu_fwd(&self, s: &CpuStorage, l: &Layout) -> Result<(CpuStorage, Shape)> {
-        let windows = self.windows(l.dims())?;
+    fn forward(&self, [x]: [&[T]; 1], [l]: [&Layout; 1]) -> Result<(Vec<T>, Shape)> {
+        let windows = windows(l.dims())?;
         let dims: Vec<usize> = l.dims()[..2].iter().chain(&windows.output).copied().collect();
-        let storage = match float_dtype(self.name(), &[s.dtype()])? {
-            DType::F32 => CpuStorage::F32(forward::<f32>(cpu_slice(s, l)?, &windows)),
-            _ => CpuStorage::F64(forward::<f64>(cpu_slice(s, l)?, &windows)),
-        };
-        Ok((storage, Shape::from(dims)))
+        Ok((forward(x, &windows), Shape::from(dims)))
     }
 
-    fn bwd(&self, x: &Tensor, res: &Tensor, grad: &Tensor) -> Result<Option<Tensor>> {
-        let windows = self.windows(x.dims())?;
-        let dx = match float_dtype(self.name(), &[x.dtype(), grad.dtype()])? {
-            DType::F32 => Tensor::from_vec(run_backward::<f32>(x, res, grad, &windows)?, x.shape(), x.device())?,
-            _ => Tensor::from_vec(run_backward::<f64>(x, res, grad, &windows)?, x.shape(), x.device())?,
-        };
-        Ok(Some(dx))
+    fn backward(
+        &self,
+        [x]: [&[T]; 1],
+        [l]: [&Layout; 1],
+        y: &[T],
+        dy: &[T],
+        _: [bool; 1],
+    ) -> Result<[Option<Vec<T>>; 1]> {
+        Ok([Some(backward(x, y, dy, &windows(l.dims())?))])
     }
-}
-
-fn run_backward<T: Float>(x: &Tensor, y: &Tensor, dy: &Tensor, windows: &Windows) -> Result<Vec<T>> {
-    with_slice(x, |x| with_slice(y, |y| with_slice(dy, |dy| Ok(backward(x, y, dy, windows)))))
 }
 
 #[cfg(test)]
 mod tests {
+    use candle_core::DType;
+
     use super::*;
     use crate::ops::testing::*;
 

@@ -1,6 +1,7 @@
 //! Test helpers: channel-major images in f64 for naive reference loops, random data, autograd
-//! of a probe loss, a finite-difference check and a relative comparison.
+//! of a probe loss, a relative comparison and (re-exported) `amber_nn`'s finite-difference check.
 
+pub use amber_nn::gradcheck::{check_finite_differences, probe_loss, values};
 use candle_core::{DType, Device, Tensor, Var};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -12,10 +13,6 @@ pub fn random_vec(len: usize, seed: u64) -> Vec<f64> {
 
 pub fn tensor(data: &[f64], dims: &[usize], dtype: DType) -> Tensor {
     Tensor::from_slice(data, dims, &Device::Cpu).unwrap().to_dtype(dtype).unwrap()
-}
-
-pub fn values(t: &Tensor) -> Vec<f64> {
-    t.to_dtype(DType::F64).unwrap().flatten_all().unwrap().to_vec1().unwrap()
 }
 
 /// A `(N, C, spatial...)` image in f64 with index helpers for naive loops.
@@ -125,33 +122,5 @@ pub fn assert_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
     let scale = b.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     for (i, (x, y)) in a.iter().zip(b).enumerate() {
         assert!((x - y).abs() <= tol * scale, "{what}: entry {i}: {x} vs {y}");
-    }
-}
-
-/// Compares autograd (f64) with central differences on up to 30 entries per input, for the
-/// loss Σ f(inputs)·w with fixed random weights w.
-pub fn check_finite_differences(inputs: &[Tensor], f: &dyn Fn(&[Tensor]) -> candle_core::Result<Tensor>) {
-    let out_dims = f(inputs).unwrap().dims().to_vec();
-    let probe = tensor(&random_vec(out_dims.iter().product(), 99), &out_dims, DType::F64);
-    let loss = |t: &[Tensor]| (f(t).unwrap() * &probe).unwrap().sum_all().unwrap().to_scalar::<f64>().unwrap();
-    let vars: Vec<Var> = inputs.iter().map(|t| Var::from_tensor(t).unwrap()).collect();
-    let tensors: Vec<Tensor> = vars.iter().map(|v| v.as_tensor().clone()).collect();
-    let grads = (f(&tensors).unwrap() * &probe).unwrap().sum_all().unwrap().backward().unwrap();
-    let eps = 1e-6;
-    for (i, var) in vars.iter().enumerate() {
-        let analytic = values(grads.get(var).expect("every input gets a gradient"));
-        let base = values(&inputs[i]);
-        for idx in (0..base.len()).step_by(base.len().div_ceil(30)) {
-            let at = |delta: f64| {
-                let mut v = base.clone();
-                v[idx] += delta;
-                let mut perturbed = inputs.to_vec();
-                perturbed[i] = tensor(&v, inputs[i].dims(), DType::F64);
-                loss(&perturbed)
-            };
-            let fd = (at(eps) - at(-eps)) / (2.0 * eps);
-            let err = (fd - analytic[idx]).abs() / fd.abs().max(analytic[idx].abs()).max(1.0);
-            assert!(err < 1e-6, "input {i} entry {idx}: finite difference {fd}, autograd {}", analytic[idx]);
-        }
     }
 }

@@ -7,10 +7,11 @@
 
 use std::sync::Arc;
 
-use candle_core::{Result, Tensor, bail};
+use amber_nn::op::{Fused, SliceOp};
+use candle_core::{Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch};
+use super::{Saved, SavedSlot, Scratch};
 use crate::graph::Topology;
 use crate::kernels::{
     BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, add_assign, add_gathered, matmul, packed_len, segment_sum,
@@ -47,14 +48,10 @@ impl EdgeUpdate {
     }
 }
 
-impl FusedMlpOp for EdgeUpdate {
+impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
     const NAME: &'static str = "amber-edge-update";
 
-    fn output_shape(&self) -> (usize, usize) {
-        (self.topology.num_edges(), self.d)
-    }
-
-    fn forward<T: Real>(&self, x: &[T], e: &[T], theta: &[T]) -> Result<Vec<T>> {
+    fn forward(&self, [x, e, theta]: [&[T]; 3], _: [&Layout; 3]) -> Result<(Vec<T>, Shape)> {
         self.check(x.len(), e.len(), theta.len())?;
         let d = self.d;
         let (n, m) = (self.topology.num_nodes(), self.topology.num_edges());
@@ -103,12 +100,19 @@ impl FusedMlpOp for EdgeUpdate {
                 |scratch, (b, (out, e))| block(b, e, scratch.state(e.len() / d, d), out),
             );
         }
-        Ok(out)
+        Ok((out, Shape::from((m, d))))
     }
 
-    fn backward<T: Real>(&self, xv: &[T], ev: &[T], tv: &[T], gv: &[T]) -> Result<[Vec<T>; 3]> {
+    fn backward(
+        &self,
+        [xv, ev, tv]: [&[T]; 3],
+        _: [&Layout; 3],
+        _: &[T],
+        gv: &[T],
+        _: [bool; 3],
+    ) -> Result<[Option<Vec<T>>; 3]> {
         self.check(xv.len(), ev.len(), tv.len())?;
-        let saved = self.saved.take(Self::NAME)?;
+        let saved = self.saved.take(<Self as SliceOp<T, 3>>::NAME)?;
         // The backward overwrites the saved activations with gradients: h1 becomes d(first-layer
         // pre-activation), h2 becomes d(e), saving two edge-sized allocations.
         let (mut dpre1, mut de) = (T::cpu_storage_data(saved.h1)?, T::cpu_storage_data(saved.h2)?);
@@ -174,7 +178,7 @@ impl FusedMlpOp for EdgeUpdate {
                 },
             );
         add_assign(&mut g.w1[..2 * d * d], &dw_nodes);
-        Ok([dx, de, g.pack(3 * d, d)])
+        Ok([Some(dx), Some(de), Some(g.pack(3 * d, d))])
     }
 }
 

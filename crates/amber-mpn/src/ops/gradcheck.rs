@@ -1,11 +1,10 @@
-//! Test helpers: a small graph with every corner case, random inputs, and a finite-difference
-//! gradient check in f64.
+//! Test helpers: a small graph with every corner case, packed parameters, the stock-candle
+//! residual MLP the fused ops must match, and (re-exported) `amber_nn`'s finite-difference check.
 
 use std::sync::Arc;
 
-use candle_core::{DType, Device, Tensor, Var};
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
+pub use amber_nn::gradcheck::{autograd, check_finite_differences, probe_loss, random, values};
+use candle_core::Tensor;
 
 use crate::graph::Topology;
 
@@ -21,51 +20,6 @@ pub fn corner_case_graph() -> Arc<Topology> {
 pub fn multi_block_graph() -> Arc<Topology> {
     let b = crate::synthetic::random_graph(700, 1000, 1, 1, 5);
     Arc::new(Topology::new(b.num_nodes, b.edge_src, b.edge_dst, b.dst_offsets).unwrap())
-}
-
-pub fn random(shape: (usize, usize), seed: u64) -> Tensor {
-    let mut rng = StdRng::seed_from_u64(seed);
-    let v: Vec<f64> = (0..shape.0 * shape.1).map(|_| rng.random_range(-1.0..1.0)).collect();
-    Tensor::from_vec(v, shape, &Device::Cpu).unwrap()
-}
-
-pub fn values(t: &Tensor) -> Vec<f64> {
-    t.to_dtype(DType::F64).unwrap().flatten_all().unwrap().to_vec1().unwrap()
-}
-
-/// Weighted sum of the output, so that every output entry gets a distinct gradient.
-pub fn probe_loss(out: &Tensor, seed: u64) -> candle_core::Result<Tensor> {
-    let w = random(out.dims2()?, seed).to_dtype(out.dtype())?;
-    (out * w)?.sum_all()
-}
-
-/// Gradients of `loss(inputs)` with respect to every input, via autograd.
-pub fn autograd(inputs: &[Tensor], loss: &dyn Fn(&[Tensor]) -> candle_core::Result<Tensor>) -> Vec<Vec<f64>> {
-    let vars: Vec<Var> = inputs.iter().map(|t| Var::from_tensor(t).unwrap()).collect();
-    let tensors: Vec<Tensor> = vars.iter().map(|v| v.as_tensor().clone()).collect();
-    let grads = loss(&tensors).unwrap().backward().unwrap();
-    vars.iter().map(|v| values(grads.get(v).expect("every input gets a gradient"))).collect()
-}
-
-/// Compares autograd with central differences (step 1e-6) on up to 40 entries per input.
-pub fn check_finite_differences(inputs: &[Tensor], loss: &dyn Fn(&[Tensor]) -> candle_core::Result<Tensor>) {
-    let analytic = autograd(inputs, loss);
-    let eval = |i: usize, idx: usize, delta: f64| {
-        let mut v = values(&inputs[i]);
-        v[idx] += delta;
-        let mut perturbed = inputs.to_vec();
-        perturbed[i] = Tensor::from_vec(v, inputs[i].shape(), &Device::Cpu).unwrap();
-        loss(&perturbed).unwrap().to_scalar::<f64>().unwrap()
-    };
-    let eps = 1e-6;
-    for (i, grad) in analytic.iter().enumerate() {
-        let step = grad.len().div_ceil(40);
-        for idx in (0..grad.len()).step_by(step) {
-            let fd = (eval(i, idx, eps) - eval(i, idx, -eps)) / (2.0 * eps);
-            let err = (fd - grad[idx]).abs() / fd.abs().max(grad[idx].abs()).max(1.0);
-            assert!(err < 1e-6, "input {i} entry {idx}: finite difference {fd}, autograd {}", grad[idx]);
-        }
-    }
 }
 
 /// Asserts two gradient sets agree to `tol` (relative to the largest entry).

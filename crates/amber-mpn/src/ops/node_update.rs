@@ -1,10 +1,11 @@
 //! The update function: `x ← LayerNorm(x + MLP_V([x, a]))` as one op, with the concatenation
 //! split into `x·W_x + a·W_a`.
 
-use candle_core::{Result, Tensor, bail};
+use amber_nn::op::{Fused, SliceOp};
+use candle_core::{Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{Fused, FusedMlpOp, Saved, SavedSlot, Scratch};
+use super::{Saved, SavedSlot, Scratch};
 use crate::kernels::{
     BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, matmul, packed_len, tail_backward, tail_forward,
 };
@@ -39,14 +40,10 @@ impl NodeUpdate {
     }
 }
 
-impl FusedMlpOp for NodeUpdate {
+impl<T: Real> SliceOp<T, 3> for NodeUpdate {
     const NAME: &'static str = "amber-node-update";
 
-    fn output_shape(&self) -> (usize, usize) {
-        (self.rows, self.d)
-    }
-
-    fn forward<T: Real>(&self, x: &[T], a: &[T], theta: &[T]) -> Result<Vec<T>> {
+    fn forward(&self, [x, a, theta]: [&[T]; 3], _: [&Layout; 3]) -> Result<(Vec<T>, Shape)> {
         self.check(x.len(), a.len(), theta.len())?;
         let (n, d) = (self.rows, self.d);
         let w = MlpWeights::unpack(theta, 2 * d, d);
@@ -85,12 +82,19 @@ impl FusedMlpOp for NodeUpdate {
                 |scratch, (out, x, a)| block(x, a, scratch.state(x.len() / d, d), out),
             );
         }
-        Ok(out)
+        Ok((out, Shape::from((n, d))))
     }
 
-    fn backward<T: Real>(&self, xv: &[T], av: &[T], tv: &[T], gv: &[T]) -> Result<[Vec<T>; 3]> {
+    fn backward(
+        &self,
+        [xv, av, tv]: [&[T]; 3],
+        _: [&Layout; 3],
+        _: &[T],
+        gv: &[T],
+        _: [bool; 3],
+    ) -> Result<[Option<Vec<T>>; 3]> {
         self.check(xv.len(), av.len(), tv.len())?;
-        let saved = self.saved.take(Self::NAME)?;
+        let saved = self.saved.take(<Self as SliceOp<T, 3>>::NAME)?;
         // As in the edge update, the saved activations are overwritten with gradients: h2 becomes
         // d(x), h1 the first-layer pre-activation gradient.
         let (mut h1, mut dx) = (T::cpu_storage_data(saved.h1)?, T::cpu_storage_data(saved.h2)?);
@@ -129,7 +133,7 @@ impl FusedMlpOp for NodeUpdate {
             )
             .map(|(g, _)| g)
             .reduce(|| MlpGrads::zeros(2 * d, d), MlpGrads::merge);
-        Ok([dx, da, g.pack(2 * d, d)])
+        Ok([Some(dx), Some(da), Some(g.pack(2 * d, d))])
     }
 }
 

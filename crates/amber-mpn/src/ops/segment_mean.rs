@@ -3,11 +3,10 @@
 
 use std::sync::Arc;
 
-use candle_core::backend::BackendStorage;
-use candle_core::{CpuStorage, CustomOp1, Layout, Result, Shape, Tensor, bail};
+use amber_nn::op::{Fused, SliceOp};
+use candle_core::{Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
-use super::{cpu_slice, float_dtype, tensor_of, tensor_slice};
 use crate::graph::Topology;
 use crate::kernels::{BLOCK_ROWS, Real, segment_sum};
 
@@ -15,7 +14,7 @@ use crate::kernels::{BLOCK_ROWS, Real, segment_sum};
 pub(crate) fn segment_mean(e: &Tensor, topology: &Arc<Topology>) -> Result<Tensor> {
     let e = e.contiguous()?;
     let d = e.dim(1)?;
-    e.apply_op1(SegmentMean { topology: topology.clone(), d })
+    e.apply_op1(Fused(SegmentMean { topology: topology.clone(), d }))
 }
 
 struct SegmentMean {
@@ -32,7 +31,7 @@ impl SegmentMean {
         (lo, hi, inv)
     }
 
-    fn forward<T: Real>(&self, e: &[T]) -> Vec<T> {
+    fn mean_rows<T: Real>(&self, e: &[T]) -> Vec<T> {
         let d = self.d;
         let mut out = vec![T::from_f64(0.0); self.topology.num_nodes() * d];
         out.par_chunks_mut(BLOCK_ROWS * d).enumerate().for_each(|(b, out)| {
@@ -45,7 +44,7 @@ impl SegmentMean {
         out
     }
 
-    fn backward<T: Real>(&self, grad: &[T]) -> Vec<T> {
+    fn spread_rows<T: Real>(&self, grad: &[T]) -> Vec<T> {
         let d = self.d;
         let offsets = self.topology.dst_offsets();
         let mut de = vec![T::from_f64(0.0); self.topology.num_edges() * d];
@@ -77,32 +76,26 @@ impl SegmentMean {
     }
 }
 
-impl CustomOp1 for SegmentMean {
-    fn name(&self) -> &'static str {
-        "amber-segment-mean"
-    }
+impl<T: Real> SliceOp<T, 1> for SegmentMean {
+    const NAME: &'static str = "amber-segment-mean";
 
-    fn cpu_fwd(&self, s: &CpuStorage, l: &Layout) -> Result<(CpuStorage, Shape)> {
+    fn forward(&self, [e]: [&[T]; 1], [l]: [&Layout; 1]) -> Result<(Vec<T>, Shape)> {
         let (m, d) = (self.topology.num_edges(), self.d);
         if l.shape().elem_count() != m * d {
             bail!("segment_mean: {} values for E={m}, D={d}", l.shape().elem_count());
         }
-        let storage = match float_dtype(self.name(), &[s.dtype()])? {
-            candle_core::DType::F32 => CpuStorage::F32(self.forward::<f32>(cpu_slice(s, l)?)),
-            _ => CpuStorage::F64(self.forward::<f64>(cpu_slice(s, l)?)),
-        };
-        Ok((storage, Shape::from((self.topology.num_nodes(), d))))
+        Ok((self.mean_rows(e), Shape::from((self.topology.num_nodes(), d))))
     }
 
-    fn bwd(&self, e: &Tensor, _res: &Tensor, grad: &Tensor) -> Result<Option<Tensor>> {
-        let grad = grad.contiguous()?;
-        let (gs, gl) = grad.storage_and_layout();
-        let shape = (self.topology.num_edges(), self.d);
-        let de = match float_dtype(self.name(), &[grad.dtype()])? {
-            candle_core::DType::F32 => tensor_of(self.backward::<f32>(tensor_slice(&gs, gl)?), shape, e)?,
-            _ => tensor_of(self.backward::<f64>(tensor_slice(&gs, gl)?), shape, e)?,
-        };
-        Ok(Some(de))
+    fn backward(
+        &self,
+        _: [&[T]; 1],
+        _: [&Layout; 1],
+        _: &[T],
+        grad: &[T],
+        _: [bool; 1],
+    ) -> Result<[Option<Vec<T>>; 1]> {
+        Ok([Some(self.spread_rows(grad))])
     }
 }
 
