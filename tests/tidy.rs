@@ -57,6 +57,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("tetgen-sys", &[]),
     ("amber-mesh", &[]),
     ("amber-testdata", &[]),
+    ("amber-plot", &["amber-mesh"]),
     ("amber-meshgen", &["amber-mesh", "tetgen-sys"]),
     ("amber-fem", &["amber-mesh", "amber-meshgen"]),
     ("amber-graph", &["amber-mesh"]),
@@ -89,6 +90,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "amber-cnn",
             "amber-tasks",
             "amber-train",
+            "amber-plot",
         ],
     ),
     (
@@ -102,6 +104,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "amber-tasks",
             "amber-train",
             "amber-experiments",
+            "amber-plot",
         ],
     ),
 ];

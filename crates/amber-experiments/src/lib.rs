@@ -9,7 +9,6 @@
 mod console;
 mod method;
 mod outputs;
-mod plots;
 mod poisson;
 mod progress;
 mod report;
@@ -19,7 +18,6 @@ mod table;
 
 pub use console::ConsoleExperiment;
 pub use method::{Method, MethodSpec, Variant};
-pub use plots::{Bar, Series, Tile, TileMesh, bar_chart, line_chart, mesh_gallery};
 pub use poisson::{PoissonExperiment, train_poisson};
 pub use progress::{TrainingProgress, item_bar};
 pub use report::{commit, config_hash, machine, merge_json, read_json, write_atomic, write_json};

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use amber_mesh::Mesh2;
+use amber_plot::{Tile, TileMesh, mesh_gallery};
 use amber_tasks::poisson::{Difficulty, PoissonProblem, Split, load_split, read_split};
 use amber_train::{CnnConfig, Profile, TrainingConfig};
 use anyhow::bail;
@@ -12,7 +13,6 @@ use serde::Serialize;
 
 use crate::method::{Method, MethodSpec, Variant};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
-use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::progress::item_bar;
 use crate::report::{commit, machine, merge_json, read_json};
 use crate::results::ExperimentResults;

@@ -142,7 +142,16 @@ pub fn write_mesh<const D: usize>(mesh: &Mesh<D>, path: impl AsRef<Path>, data: 
 
 /// Writes a file through `write` into a temporary file in the same directory, then renames it
 /// over `path`, so the file is either absent, the old one, or complete. Io errors name `path`.
-pub(crate) fn write_atomic(
+///
+/// ```no_run
+/// use std::io::Write;
+/// let path = std::path::Path::new("notes.txt");
+/// amber_mesh::write_atomic(path, |w| {
+///     w.write_all(b"hello").map_err(|source| amber_mesh::MeshError::Io { path: path.to_owned(), source })
+/// })?;
+/// # Ok::<(), amber_mesh::MeshError>(())
+/// ```
+pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> Result<(), MeshError>,
 ) -> Result<(), MeshError> {
