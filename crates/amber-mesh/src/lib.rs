@@ -2,9 +2,10 @@
 //!
 //! A [`Mesh<D>`] holds vertices and positively oriented simplices (triangles for `D = 2`,
 //! tetrahedra for `D = 3`). It answers per-element geometry (volume, midpoint, the element size
-//! h(K) of spec §0), facet adjacency ([`FacetAdjacency`]), point location ([`PointLocator`]), and
-//! reads and writes meshes ([`read_mesh`], [`write_mesh`]: `.vtu`, gmsh `.msh` 4.1, JSON, NASTRAN `.nas`
-//! read only).
+//! h(K) of spec §0), facet adjacency ([`FacetAdjacency`]) and point location ([`PointLocator`]).
+//! It reads and writes meshes ([`read_mesh`], [`write_mesh`]: `.vtu`, gmsh `.msh` 4.1, JSON,
+//! NASTRAN `.nas` read only) and reads the triangles of surface files ([`read_surface`]: binary
+//! and ASCII STL, OBJ).
 //!
 //! This crate knows nothing of sizing fields, mesh generation, FEM, graphs or learning.
 
@@ -16,6 +17,8 @@ mod mesh;
 
 pub use adjacency::FacetAdjacency;
 pub use error::MeshError;
-pub use io::{MeshData, read_mesh, read_mesh_with_data, write_atomic, write_mesh};
+pub use io::{
+    MeshData, StlFaceIds, TriangleSoup, read_mesh, read_mesh_with_data, read_surface, write_atomic, write_mesh,
+};
 pub use locate::{Location, PointLocator};
 pub use mesh::{Mesh, Mesh2, Mesh3, centroid, signed_volume, size_from_volume, volume_from_size};
