@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use amber_fem::{ExpertHeuristic, P1Space, Quadrature, element_stats};
-use amber_mesh::{RenderOptions, render_png};
+use amber_plot::{RenderOptions, render_png};
 use amber_tasks::poisson::{
     DatasetManifest, Difficulty, INITIAL_SIZE, PoissonProblem, Split, SplitRequest, read_split, split_dir, write_split,
 };

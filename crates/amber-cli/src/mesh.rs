@@ -3,8 +3,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use amber_mesh::{Mesh2, MeshData, RenderOptions, read_mesh_with_data, render_png, write_mesh};
+use amber_mesh::{Mesh2, MeshData, read_mesh_with_data, write_mesh};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
+use amber_plot::{RenderOptions, render_png};
 use anyhow::{Context, bail};
 use clap::Args;
 

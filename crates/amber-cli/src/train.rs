@@ -4,7 +4,8 @@
 use std::path::PathBuf;
 
 use amber_experiments::{Method, amber_config, merge_json, train_poisson};
-use amber_mesh::{MeshData, RenderOptions, render_png, write_mesh};
+use amber_mesh::{MeshData, write_mesh};
+use amber_plot::{RenderOptions, render_png};
 use amber_stdx::read_json;
 use amber_tasks::poisson::{Difficulty, read_problem};
 use amber_train::{AmberModel, Evaluation, MODEL_DIR, Profile, StepStatus};

@@ -5,7 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use amber_mesh::{Mesh3, View};
+use amber_mesh::Mesh3;
+use amber_plot::{Tile, TileMesh, View, mesh_gallery};
 use amber_tasks::console::{ConsoleProblem, ConsoleSplit, INITIAL_MESH_RECIPE, TrainSet, has_test_split, part_names};
 use amber_train::Profile;
 use anyhow::bail;
@@ -14,7 +15,6 @@ use serde::Serialize;
 
 use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
-use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::profiles::{Task, amber_config, cnn_config};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};

@@ -9,7 +9,6 @@
 mod console;
 mod method;
 mod outputs;
-mod plots;
 mod poisson;
 mod profiles;
 mod progress;
@@ -20,7 +19,6 @@ mod table;
 
 pub use console::ConsoleExperiment;
 pub use method::{Method, MethodSpec, Variant};
-pub use plots::{Bar, Series, Tile, TileMesh, bar_chart, line_chart, mesh_gallery};
 pub use poisson::{PoissonExperiment, train_poisson};
 pub use profiles::{Task, amber_config, cnn_config};
 pub use progress::{TrainingProgress, item_bar};

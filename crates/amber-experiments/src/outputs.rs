@@ -3,8 +3,9 @@
 
 use std::path::Path;
 
+use amber_plot::{Bar, Series, Tile, bar_chart, line_chart};
+
 use crate::method::MethodSpec;
-use crate::plots::{Bar, Series, Tile, bar_chart, line_chart};
 use crate::report::{write_atomic, write_json};
 use crate::results::{ExperimentResults, RunResult};
 use crate::table::{self, PaperNumber};

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use amber_mesh::Mesh2;
+use amber_plot::{Tile, TileMesh, mesh_gallery};
 use amber_stdx::read_json;
 use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
@@ -15,7 +16,6 @@ use serde::Serialize;
 
 use crate::method::{Method, MethodSpec, Variant};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
-use crate::plots::{Tile, TileMesh, mesh_gallery};
 use crate::profiles::{Task, amber_config, cnn_config};
 use crate::progress::item_bar;
 use crate::report::merge_json;

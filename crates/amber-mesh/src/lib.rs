@@ -2,9 +2,10 @@
 //!
 //! A [`Mesh<D>`] holds vertices and positively oriented simplices (triangles for `D = 2`,
 //! tetrahedra for `D = 3`). It answers per-element geometry (volume, midpoint, the element size
-//! h(K) of spec §0), facet adjacency ([`FacetAdjacency`]), point location ([`PointLocator`]), and
-//! reads and writes meshes ([`read_mesh`], [`write_mesh`]: `.vtu`, gmsh `.msh` 4.1, JSON, NASTRAN `.nas`
-//! read only) and renders 2D meshes to PNG ([`render_png`]).
+//! h(K) of spec §0), facet adjacency ([`FacetAdjacency`]) and point location ([`PointLocator`]).
+//! It reads and writes meshes ([`read_mesh`], [`write_mesh`]: `.vtu`, gmsh `.msh` 4.1, JSON,
+//! NASTRAN `.nas` read only) and reads the triangles of surface files ([`read_surface`]: binary
+//! and ASCII STL, OBJ).
 //!
 //! This crate knows nothing of sizing fields, mesh generation, FEM, graphs or learning.
 
@@ -13,14 +14,9 @@ mod error;
 mod io;
 mod locate;
 mod mesh;
-mod render;
 
 pub use adjacency::FacetAdjacency;
 pub use error::MeshError;
-pub use io::{MeshData, read_mesh, read_mesh_with_data, write_mesh};
+pub use io::{MeshData, StlFaceIds, TriangleSoup, read_mesh, read_mesh_with_data, read_surface, write_mesh};
 pub use locate::{Location, PointLocator};
 pub use mesh::{Mesh, Mesh2, Mesh3, centroid, signed_volume, size_from_volume, volume_from_size};
-pub use render::{
-    MISSING_COLOUR, RenderOptions, View, register_default_font, render_png, render_rgb, render_surface_png,
-    render_surface_rgb, viridis, write_png,
-};

@@ -1,15 +1,19 @@
 //! Reading and writing meshes, one entry point per direction, dispatching on the file extension:
 //! `.vtu` (VTK XML, binary), `.msh` (gmsh 4.1 ASCII), `.json`, and `.nas` (NASTRAN bulk data,
-//! read only).
+//! read only); and reading triangle surfaces, `.stl` (binary or ASCII) and `.obj`, as the plain
+//! triangles the file lists ([`TriangleSoup`]).
 //!
-//! Every reader keeps only the simplices of the mesh dimension, drops vertices no kept element
-//! uses (a stray vertex would make an FEM system singular) and flips negatively oriented
-//! elements. Every writer writes to a temporary file beside the target, fsyncs it and renames it
-//! (amber-stdx's `write_atomic_with`), so a reader never sees a half-written mesh.
+//! Every mesh reader keeps only the simplices of the mesh dimension, drops vertices no kept
+//! element uses (a stray vertex would make an FEM system singular) and flips negatively oriented
+//! elements. Surfaces are read as they are: welding and checking them is the mesher's job. Every
+//! writer writes to a temporary file beside the target, fsyncs it and renames it (amber-stdx's
+//! `write_atomic_with`), so a reader never sees a half-written file.
 
 mod json;
 mod msh;
 mod nastran;
+mod obj;
+mod stl;
 mod vtu;
 
 use std::collections::BTreeMap;
@@ -113,6 +117,62 @@ pub fn read_mesh_with_data<const D: usize>(path: impl AsRef<Path>) -> Result<(Me
         Format::Json => json::read(path, &bytes),
         Format::Nastran => nastran::read(path, &bytes),
     }
+}
+
+/// Where the face ids of an STL file come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StlFaceIds {
+    /// Binary STL: the 2-byte facet attribute (as gmsh-made reference surfaces store it);
+    /// ASCII STL: the 1-based index of the `solid` block.
+    FromFile,
+    /// Every triangle gets face id 1 (plain STL, attribute ignored).
+    Single,
+}
+
+/// The triangles of a surface file as it lists them: three corners per triangle (shared
+/// vertices repeated, nothing welded or checked) and a face id per triangle.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleSoup {
+    /// `3 × face_ids.len()` corner positions, triangle after triangle.
+    pub corners: Vec<[f64; 3]>,
+    /// The face id of every triangle: from the STL file as `stl_face_ids` says, or the 1-based
+    /// `g`/`o` group of an OBJ file in order of appearance.
+    pub face_ids: Vec<i32>,
+}
+
+const SURFACE_FORMATS: &str = ".stl, .obj";
+
+/// Reads the triangles of a surface file, choosing the format by extension: `.stl` (binary when
+/// the file size matches its facet count, else ASCII; face ids as `stl_face_ids` says) or
+/// `.obj` (polygons fanned into triangles, one face id per `g`/`o` group). Errors name the file
+/// and, for text, the line.
+///
+/// ```no_run
+/// use amber_mesh::{StlFaceIds, read_surface};
+/// let soup = read_surface("part.stl", StlFaceIds::FromFile)?;
+/// assert_eq!(soup.corners.len(), 3 * soup.face_ids.len());
+/// # Ok::<(), amber_mesh::MeshError>(())
+/// ```
+pub fn read_surface(path: impl AsRef<Path>, stl_face_ids: StlFaceIds) -> Result<TriangleSoup, MeshError> {
+    let path = path.as_ref();
+    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let is_stl = match extension.as_deref() {
+        Some("stl") => true,
+        Some("obj") => false,
+        _ => return Err(MeshError::UnsupportedFormat { path: path.to_owned(), expected: SURFACE_FORMATS }),
+    };
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
+    if is_stl { stl::read(path, &bytes, stl_face_ids) } else { obj::read(path, &bytes) }
+}
+
+/// Three whitespace-separated coordinates; the error says which word is wrong.
+fn parse_point<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<[f64; 3], String> {
+    let mut p = [0.0; 3];
+    for x in &mut p {
+        let word = words.next().ok_or("expected 3 coordinates")?;
+        *x = word.parse().map_err(|_| format!("`{word}` is not a number"))?;
+    }
+    Ok(p)
 }
 
 /// Writes a mesh with optional scalar fields, choosing the format by extension (`.vtu`, `.msh`,
@@ -286,6 +346,27 @@ mod tests {
         assert!(matches!(err, MeshError::UnsupportedFormat { .. }), "{err}");
         assert!(matches!(read_mesh::<2>(dir.join("m")), Err(MeshError::UnsupportedFormat { .. })));
         assert!(matches!(read_mesh::<2>(dir.join("missing.vtu")), Err(MeshError::Io { .. })));
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn surfaces_are_read_by_extension_and_errors_name_the_file() {
+        let dir = test_dir("surface");
+        let path = dir.join("tri.OBJ");
+        std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let soup = read_surface(&path, StlFaceIds::FromFile).unwrap();
+        assert_eq!(
+            soup,
+            TriangleSoup { corners: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], face_ids: vec![1] }
+        );
+        let bad = dir.join("bad.obj");
+        std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap();
+        let err = read_surface(&bad, StlFaceIds::Single).unwrap_err();
+        assert!(matches!(err, MeshError::Parse { line: 3, .. }) && err.to_string().contains("bad.obj"), "{err}");
+        let err = read_surface(dir.join("missing.stl"), StlFaceIds::FromFile).unwrap_err();
+        assert!(matches!(err, MeshError::Io { .. }) && err.to_string().contains("missing.stl"), "{err}");
+        let err = read_surface(dir.join("x.ply"), StlFaceIds::FromFile).unwrap_err();
+        assert!(matches!(err, MeshError::UnsupportedFormat { .. }) && err.to_string().contains("x.ply"), "{err}");
         std::fs::remove_dir_all(dir).unwrap();
     }
 

@@ -1,10 +1,10 @@
 //! The 3D mesh generator: closed CAD-face-labelled surfaces in, tetrahedral meshes out.
 //!
-//! [`surface`] reads and validates the geometry (STL with CAD face ids, plain STL, OBJ);
-//! [`mod@remesh`] adapts the surface to a sizing field, keeping CAD faces, curves and corners;
-//! [`tetgen`] fills a closed surface with tets following the same field; [`generate_3d`] runs
-//! both, capped by curvature and by an element budget. Exact predicates and triangle
-//! intersection tests are private helpers.
+//! [`surface`] welds and validates the geometry whose triangles amber-mesh reads (STL with CAD
+//! face ids, plain STL, OBJ); [`mod@remesh`] adapts the surface to a sizing field, keeping CAD
+//! faces, curves and corners; [`tetgen`] fills a closed surface with tets following the same
+//! field; [`generate_3d`] runs both, capped by curvature and by an element budget. Exact
+//! predicates and triangle intersection tests are private helpers.
 
 mod generate;
 mod intersect;

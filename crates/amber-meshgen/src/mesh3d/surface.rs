@@ -1,14 +1,18 @@
-//! Closed triangle surfaces with a CAD-face id per triangle: reading (STL, OBJ), welding
-//! duplicate vertices, and the checks TetGen needs of its input — closed, 2-manifold,
-//! consistently oriented with outward normals, free of self-intersections.
+//! Closed triangle surfaces with a CAD-face id per triangle: built from the triangles of an
+//! STL or OBJ file (which amber-mesh reads), welding duplicate vertices, and the checks TetGen
+//! needs of its input — closed, 2-manifold, consistently oriented with outward normals, free of
+//! self-intersections.
 //!
 //! The Console reference surfaces (`data/console/reference_surface/*/NNN.stl`) are binary STL
-//! in mm whose 2-byte facet attribute holds the 1-based CAD face id: read them with
+//! in mm whose 2-byte facet attribute holds the 1-based CAD face id: load them with
 //! [`StlFaceIds::FromFile`].
 
 use std::cmp::Ordering;
 use std::collections::{HashMap, VecDeque};
 use std::path::{Path, PathBuf};
+
+pub use amber_mesh::StlFaceIds;
+use amber_mesh::{MeshError, read_surface};
 
 use super::intersect::intersecting_pairs;
 use super::predicates::orient2d;
@@ -31,16 +35,6 @@ impl PartialEq for Surface {
     fn eq(&self, other: &Self) -> bool {
         (&self.vertices, &self.triangles, &self.face_ids) == (&other.vertices, &other.triangles, &other.face_ids)
     }
-}
-
-/// Where the CAD face ids of an STL file come from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StlFaceIds {
-    /// Binary STL: the 2-byte facet attribute (as gmsh-made reference surfaces store it);
-    /// ASCII STL: the 1-based index of the `solid` block.
-    FromFile,
-    /// Every triangle gets face id 1 (plain STL, attribute ignored).
-    Single,
 }
 
 /// What [`Surface::validate`] found and did.
@@ -67,15 +61,10 @@ impl SurfaceReport {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SurfaceError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
-    /// The file content is malformed.
-    #[error("{path}: {message}")]
-    Parse { path: PathBuf, message: String },
-    /// The extension names no supported format.
-    #[error("{path}: unsupported surface format (expected .stl or .obj)")]
-    UnsupportedFormat { path: PathBuf },
+    /// The file could not be read, is malformed, or its extension names no surface format
+    /// (the error names the file).
+    #[error(transparent)]
+    Read(#[from] MeshError),
     /// The file was read but the surface does not bound a solid.
     #[error("{path}: {source}")]
     Defect { path: PathBuf, source: SurfaceDefect },
@@ -182,36 +171,14 @@ impl Surface {
         Self::new(vertices, triangles, face_ids)
     }
 
-    /// Reads a binary or ASCII STL file (binary when the size matches its facet count).
-    pub fn read_stl(path: impl AsRef<Path>, face_ids: StlFaceIds) -> Result<Self, SurfaceError> {
-        let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|source| SurfaceError::Io { path: path.into(), source })?;
-        let (corners, ids) =
-            parse_stl(&bytes, face_ids).map_err(|message| SurfaceError::Parse { path: path.into(), message })?;
-        Self::from_triangle_soup(&corners, ids, 0.0)
-            .map_err(|source| SurfaceError::Defect { path: path.into(), source })
-    }
-
-    /// Reads a Wavefront OBJ file: `v` and `f` lines (polygons are fanned into triangles, so
-    /// they must be convex); each `g`/`o` group becomes a face id, 1-based in order of appearance.
-    pub fn read_obj(path: impl AsRef<Path>) -> Result<Self, SurfaceError> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SurfaceError::Io { path: path.into(), source })?;
-        let (corners, ids) = parse_obj(&text).map_err(|message| SurfaceError::Parse { path: path.into(), message })?;
-        Self::from_triangle_soup(&corners, ids, 0.0)
-            .map_err(|source| SurfaceError::Defect { path: path.into(), source })
-    }
-
-    /// Reads an `.stl` or `.obj` file and [validates](Surface::validate) it; every error names the file.
+    /// Reads an `.stl` or `.obj` file ([`amber_mesh::read_surface`]), welds bit-identical
+    /// corners and [validates](Surface::validate) the surface; every error names the file.
     pub fn load(path: impl AsRef<Path>, stl_face_ids: StlFaceIds) -> Result<(Self, SurfaceReport), SurfaceError> {
         let path = path.as_ref();
-        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-        let mut surface = match extension.as_deref() {
-            Some("stl") => Self::read_stl(path, stl_face_ids)?,
-            Some("obj") => Self::read_obj(path)?,
-            _ => return Err(SurfaceError::UnsupportedFormat { path: path.into() }),
-        };
-        let report = surface.validate().map_err(|source| SurfaceError::Defect { path: path.into(), source })?;
+        let soup = read_surface(path, stl_face_ids)?;
+        let defect = |source| SurfaceError::Defect { path: path.into(), source };
+        let mut surface = Self::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(defect)?;
+        let report = surface.validate().map_err(defect)?;
         Ok((surface, report))
     }
 
@@ -477,148 +444,17 @@ fn weld(corners: &[[f64; 3]], tolerance: f64) -> (Vec<[f64; 3]>, Vec<u32>) {
     (vertices, index)
 }
 
-/// Corners and face ids of an STL file; errors say where.
-fn parse_stl(bytes: &[u8], face_ids: StlFaceIds) -> Result<(Vec<[f64; 3]>, Vec<i32>), String> {
-    if bytes.len() >= 84 {
-        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
-        if bytes.len() as u64 == 84 + 50 * n as u64 {
-            return Ok(parse_binary_stl(&bytes[84..], n, face_ids));
-        }
-    }
-    if bytes.trim_ascii_start().starts_with(b"solid") {
-        let text = std::str::from_utf8(bytes).map_err(|e| format!("ASCII STL is not valid UTF-8: {e}"))?;
-        return parse_ascii_stl(text, face_ids);
-    }
-    Err(format!(
-        "not an STL file: {} bytes match no binary facet count and the text does not start with `solid`",
-        bytes.len()
-    ))
-}
-
-fn parse_binary_stl(facets: &[u8], n: usize, face_ids: StlFaceIds) -> (Vec<[f64; 3]>, Vec<i32>) {
-    let f32_at = |b: &[u8], i: usize| f32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]) as f64;
-    let mut corners = Vec::with_capacity(3 * n);
-    let mut ids = Vec::with_capacity(n);
-    for facet in facets.chunks_exact(50) {
-        // Bytes 0..12 hold the normal, which is recomputed from the corners when needed.
-        for k in 0..3 {
-            let at = 12 + 12 * k;
-            corners.push([f32_at(facet, at), f32_at(facet, at + 4), f32_at(facet, at + 8)]);
-        }
-        ids.push(match face_ids {
-            StlFaceIds::FromFile => u16::from_le_bytes([facet[48], facet[49]]) as i32,
-            StlFaceIds::Single => 1,
-        });
-    }
-    (corners, ids)
-}
-
-fn parse_ascii_stl(text: &str, face_ids: StlFaceIds) -> Result<(Vec<[f64; 3]>, Vec<i32>), String> {
-    let mut corners = Vec::new();
-    let mut ids = Vec::new();
-    let mut solid = 0;
-    let mut facet: Vec<[f64; 3]> = Vec::with_capacity(3);
-    for (number, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("solid") => solid += 1,
-            Some("facet") => facet.clear(),
-            Some("vertex") => facet.push(parse_coordinates(words).map_err(|e| format!("line {}: {e}", number + 1))?),
-            Some("endfacet") => {
-                if facet.len() != 3 {
-                    return Err(format!(
-                        "line {}: facet with {} vertices (only triangles are supported)",
-                        number + 1,
-                        facet.len()
-                    ));
-                }
-                corners.append(&mut facet);
-                ids.push(if face_ids == StlFaceIds::FromFile { solid } else { 1 });
-            }
-            _ => {}
-        }
-    }
-    Ok((corners, ids))
-}
-
-fn parse_coordinates<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<[f64; 3], String> {
-    let mut p = [0.0; 3];
-    for x in &mut p {
-        let word = words.next().ok_or("expected 3 coordinates")?;
-        *x = word.parse().map_err(|_| format!("`{word}` is not a number"))?;
-    }
-    Ok(p)
-}
-
-fn parse_obj(text: &str) -> Result<(Vec<[f64; 3]>, Vec<i32>), String> {
-    let mut vertices: Vec<[f64; 3]> = Vec::new();
-    let mut corners = Vec::new();
-    let mut ids = Vec::new();
-    let mut group_ids: HashMap<String, i32> = HashMap::new();
-    let mut group = String::new();
-    for (number, line) in text.lines().enumerate() {
-        let at = |e: String| format!("line {}: {e}", number + 1);
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => vertices.push(parse_coordinates(words).map_err(at)?),
-            Some("g" | "o") => group = words.collect::<Vec<_>>().join(" "),
-            Some("f") => {
-                let polygon = words.map(|w| obj_index(w, vertices.len())).collect::<Result<Vec<_>, _>>().map_err(at)?;
-                if polygon.len() < 3 {
-                    return Err(at(format!("face with {} vertices", polygon.len())));
-                }
-                let next_id = group_ids.len() as i32 + 1;
-                let id = *group_ids.entry(group.clone()).or_insert(next_id);
-                for k in 1..polygon.len() - 1 {
-                    corners.extend([polygon[0], polygon[k], polygon[k + 1]].map(|v| vertices[v]));
-                    ids.push(id);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok((corners, ids))
-}
-
-/// A face corner `v`, `v/vt`, `v//vn` or `v/vt/vn`; 1-based, negative counts back from the end.
-fn obj_index(word: &str, num_vertices: usize) -> Result<usize, String> {
-    let v = word.split('/').next().unwrap_or(word);
-    let i: i64 = v.parse().map_err(|_| format!("`{word}` is not a vertex index"))?;
-    let index = if i < 0 { num_vertices as i64 + i } else { i - 1 };
-    if (0..num_vertices as i64).contains(&index) {
-        Ok(index as usize)
-    } else {
-        Err(format!("vertex index {i} out of range (1..={num_vertices})"))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh3d::console_reference_surfaces;
+    use crate::mesh3d::{console_reference_surfaces, unit_cube_triangles};
 
-    const CUBE_OBJ: &str = "# unit cube of quads in three groups; 'top' is inside out\n\
-        v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
-        g bottom\nf 1 4 3 2\ng top\nf 5 8 7 6\n\
-        g sides\nf 1 2 6 5\nf 2/1 3/2 7/3 6/4\nf 3//1 4//1 8//1 7//1\nf -1 -5 -8 -4\n";
-
-    fn obj_cube() -> Surface {
-        let (corners, ids) = parse_obj(CUBE_OBJ).unwrap();
+    /// The unit cube as a triangle soup, one face id per side, with its top side inside out.
+    fn cube() -> Surface {
+        let (vertices, mut triangles, ids) = unit_cube_triangles();
+        triangles[2..4].iter_mut().for_each(|t| t.swap(1, 2));
+        let corners: Vec<[f64; 3]> = triangles.iter().flat_map(|t| t.map(|v| vertices[v as usize])).collect();
         Surface::from_triangle_soup(&corners, ids, 0.0).unwrap()
-    }
-
-    /// Binary STL bytes of the given triangles with the given attributes.
-    fn binary_stl(corners: &[[f64; 3]], attributes: &[u16]) -> Vec<u8> {
-        let mut bytes = vec![b' '; 80];
-        bytes.extend((attributes.len() as u32).to_le_bytes());
-        for (t, a) in attributes.iter().enumerate() {
-            bytes.extend([0u8; 12]);
-            for p in &corners[3 * t..3 * t + 3] {
-                p.iter().for_each(|&x| bytes.extend((x as f32).to_le_bytes()));
-            }
-            bytes.extend(a.to_le_bytes());
-        }
-        bytes
     }
 
     fn soup(s: &Surface) -> Vec<[f64; 3]> {
@@ -626,12 +462,12 @@ mod tests {
     }
 
     #[test]
-    fn obj_cube_is_welded_validated_and_turned_outward() {
-        let mut s = obj_cube();
+    fn cube_soup_is_welded_validated_and_turned_outward() {
+        let mut s = cube();
         assert_eq!((s.vertices().len(), s.triangles().len()), (8, 12));
         let mut ids = s.face_ids().to_vec();
         ids.dedup();
-        assert_eq!(ids, [1, 2, 3]);
+        assert_eq!(ids, [1, 2, 3, 4, 5, 6]);
         let report = s.validate().unwrap();
         assert_eq!(report.components, 1);
         assert_eq!(report.flipped_triangles, 2);
@@ -641,7 +477,7 @@ mod tests {
 
     #[test]
     fn inside_out_surface_is_reversed_whole() {
-        let mut s = obj_cube();
+        let mut s = cube();
         s.validate().unwrap();
         s.triangles.iter_mut().for_each(|t| t.swap(0, 1));
         assert!(s.enclosed_volume() < 0.0);
@@ -650,59 +486,40 @@ mod tests {
     }
 
     #[test]
-    fn binary_and_ascii_stl_carry_face_ids() {
-        let cube = obj_cube();
-        let corners = soup(&cube);
-        let attributes: Vec<u16> = (0..12).map(|t| t / 2 + 1).collect();
-        let (c, ids) = parse_stl(&binary_stl(&corners, &attributes), StlFaceIds::FromFile).unwrap();
-        assert_eq!((c, ids.clone()), (corners.clone(), attributes.iter().map(|&a| a as i32).collect::<Vec<_>>()));
-        let (_, single) = parse_stl(&binary_stl(&corners, &attributes), StlFaceIds::Single).unwrap();
-        assert!(single.iter().all(|&i| i == 1));
-        let mut ascii = String::from("solid a\n");
-        for (t, tri) in corners.chunks(3).enumerate() {
-            if t == 6 {
-                ascii += "endsolid a\nsolid b\n";
-            }
-            ascii += "  facet normal 0 0 0\n    outer loop\n";
-            tri.iter().for_each(|p| ascii += &format!("      vertex {} {} {}\n", p[0], p[1], p[2]));
-            ascii += "    endloop\n  endfacet\n";
-        }
-        ascii += "endsolid b\n";
-        let (c, ids) = parse_stl(ascii.as_bytes(), StlFaceIds::FromFile).unwrap();
-        assert_eq!(c, corners);
-        assert_eq!(ids, [1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2]);
-    }
-
-    #[test]
     fn file_errors_name_the_file() {
         let dir = std::env::temp_dir().join(format!("amber-surface-test-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let bad = dir.join("bad.obj");
         std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap();
-        let err = Surface::load(&bad, StlFaceIds::Single).unwrap_err().to_string();
-        assert!(err.contains("bad.obj") && err.contains("line 3"), "{err}");
-        // A cube missing one triangle: readable, but not closed.
-        let open = dir.join("open.stl");
-        let corners = soup(&obj_cube());
-        std::fs::write(&open, binary_stl(&corners[..33], &[1; 11])).unwrap();
+        let err = Surface::load(&bad, StlFaceIds::Single).unwrap_err();
+        assert!(matches!(err, SurfaceError::Read(MeshError::Parse { line: 3, .. })), "{err}");
+        assert!(err.to_string().contains("bad.obj"), "{err}");
+        // A cube missing one triangle of its bottom: readable, but not closed.
+        let open = dir.join("open.obj");
+        std::fs::write(
+            &open,
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+            f 1 4 3\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+        )
+        .unwrap();
         let err = Surface::load(&open, StlFaceIds::FromFile).unwrap_err();
         assert!(
             matches!(&err, SurfaceError::Defect { source: SurfaceDefect::OpenEdges { count: 3, .. }, .. }),
             "{err}"
         );
-        assert!(err.to_string().contains("open.stl"));
+        assert!(err.to_string().contains("open.obj"));
         let missing = Surface::load(dir.join("missing.stl"), StlFaceIds::FromFile).unwrap_err();
-        assert!(matches!(missing, SurfaceError::Io { .. }));
+        assert!(matches!(missing, SurfaceError::Read(MeshError::Io { .. })));
         assert!(matches!(
             Surface::load(dir.join("x.ply"), StlFaceIds::FromFile),
-            Err(SurfaceError::UnsupportedFormat { .. })
+            Err(SurfaceError::Read(MeshError::UnsupportedFormat { .. }))
         ));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn tolerance_welding_closes_cracks() {
-        let mut corners = soup(&obj_cube());
+        let mut corners = soup(&cube());
         corners[0][0] += 1e-9;
         let mut exact = Surface::from_triangle_soup(&corners, vec![1; 12], 0.0).unwrap();
         assert_eq!(exact.vertices().len(), 9);
@@ -714,7 +531,7 @@ mod tests {
 
     #[test]
     fn non_manifold_and_degenerate_surfaces_are_rejected() {
-        let cube = obj_cube();
+        let cube = cube();
         let corners = soup(&cube);
         // Two cubes sharing one corner vertex: every edge is fine, the vertex is not.
         let mut two = corners.clone();
@@ -739,7 +556,7 @@ mod tests {
 
     #[test]
     fn overlapping_shells_are_a_self_intersection() {
-        let corners = soup(&obj_cube());
+        let corners = soup(&cube());
         let mut two = corners.clone();
         two.extend(corners.iter().map(|p| [p[0] + 0.5, p[1] + 0.25, p[2] + 0.125]));
         let mut s = Surface::from_triangle_soup(&two, (0..24).map(|t| t / 12 + 1).collect(), 0.0).unwrap();

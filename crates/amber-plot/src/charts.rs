@@ -1,17 +1,17 @@
-//! The pictures of an experiment: normalised-DCD bars per difficulty, normalised DCD per
-//! generation step, and galleries of meshes. Drawn with plotters into memory and written
-//! atomically.
+//! Charts: bars with quantile whiskers in one panel per group, and lines with markers and a
+//! legend. Drawn with plotters into memory and written atomically.
 
 use std::path::Path;
 
-use amber_mesh::{Mesh2, Mesh3, RenderOptions, View, register_default_font, render_rgb, render_surface_rgb, write_png};
-use anyhow::{Context, anyhow};
 use plotters::coord::ranged1d::SegmentValue;
 use plotters::prelude::*;
 
+use crate::error::draw_error;
+use crate::font::{FONT_FAMILY, register_default_font};
+use crate::{PlotError, write_png};
+
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 620;
-const FONT: &str = "sans-serif";
 
 /// Distinct colours for up to ten series (matplotlib's tab10).
 const PALETTE: [RGBColor; 10] = [
@@ -42,13 +42,9 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-fn plot_error(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("drawing failed: {e}")
-}
-
 /// One panel per group (e.g. difficulty) with a bar per method, whiskers at the quantiles, the
 /// mean written above each bar.
-pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec<Bar>)]) -> anyhow::Result<()> {
+pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec<Bar>)]) -> Result<(), PlotError> {
     register_default_font();
     // Wide enough for every bar's label (~7 px per character at the label font).
     let bars_total: usize = groups.iter().map(|(_, bars)| bars.len()).sum();
@@ -58,7 +54,7 @@ pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec
     let mut rgb = vec![255u8; 3 * (width * HEIGHT) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (width, HEIGHT)).into_drawing_area();
-        let root = root.titled(title, (FONT, 26)).map_err(plot_error)?;
+        let root = root.titled(title, (FONT_FAMILY, 26)).map_err(draw_error(path))?;
         let panels = root.split_evenly((1, groups.len().max(1)));
         let top = groups
             .iter()
@@ -70,18 +66,18 @@ pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec
         for (panel, (group, bars)) in panels.iter().zip(groups) {
             let names: Vec<String> = bars.iter().map(|b| b.label.clone()).collect();
             let mut chart = ChartBuilder::on(panel)
-                .caption(group, (FONT, 22))
+                .caption(group, (FONT_FAMILY, 22))
                 .margin(12)
                 .x_label_area_size(40)
                 .y_label_area_size(60)
                 // A segmented range a..b has b − a + 1 segments.
                 .build_cartesian_2d((0..bars.len() as i32 - 1).into_segmented(), 0.0..top)
-                .map_err(plot_error)?;
+                .map_err(draw_error(path))?;
             chart
                 .configure_mesh()
                 .disable_x_mesh()
                 .y_desc(y_label)
-                .label_style((FONT, 13))
+                .label_style((FONT_FAMILY, 13))
                 // One label per bar: plotters draws at most ten by default.
                 .x_labels(bars.len())
                 .x_label_formatter(&|v| match v {
@@ -89,7 +85,7 @@ pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec
                     _ => String::new(),
                 })
                 .draw()
-                .map_err(plot_error)?;
+                .map_err(draw_error(path))?;
             for (i, bar) in bars.iter().enumerate() {
                 let i = i as i32;
                 let colour = PALETTE[i as usize % PALETTE.len()];
@@ -98,7 +94,7 @@ pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec
                     colour.mix(0.85).filled(),
                 );
                 rect.set_margin(0, 0, 12, 12);
-                chart.draw_series(std::iter::once(rect)).map_err(plot_error)?;
+                chart.draw_series(std::iter::once(rect)).map_err(draw_error(path))?;
                 chart
                     .draw_series(std::iter::once(PathElement::new(
                         vec![
@@ -107,27 +103,27 @@ pub fn bar_chart(path: &Path, title: &str, y_label: &str, groups: &[(String, Vec
                         ],
                         BLACK.stroke_width(2),
                     )))
-                    .map_err(plot_error)?;
+                    .map_err(draw_error(path))?;
                 let above = bar.quantiles[1].max(bar.mean) + 0.02 * top;
                 chart
                     .draw_series(std::iter::once(Text::new(
                         format!("{:.3}", bar.mean),
                         (SegmentValue::CenterOf(i), above),
-                        (FONT, 16).into_font().color(&BLACK).pos(plotters::style::text_anchor::Pos::new(
+                        (FONT_FAMILY, 16).into_font().color(&BLACK).pos(plotters::style::text_anchor::Pos::new(
                             plotters::style::text_anchor::HPos::Center,
                             plotters::style::text_anchor::VPos::Bottom,
                         )),
                     )))
-                    .map_err(plot_error)?;
+                    .map_err(draw_error(path))?;
             }
         }
-        root.present().map_err(plot_error)?;
+        root.present().map_err(draw_error(path))?;
     }
-    write_png(path, width, HEIGHT, &rgb).with_context(|| format!("{}: cannot write the chart", path.display()))
+    write_png(path, width, HEIGHT, &rgb)
 }
 
 /// Lines with markers, one per series, with a legend.
-pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> anyhow::Result<()> {
+pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<(), PlotError> {
     register_default_font();
     let points = || series.iter().flat_map(|s| s.points.iter()).filter(|(x, y)| x.is_finite() && y.is_finite());
     let x_max = points().map(|p| p.0).fold(1.0f64, f64::max);
@@ -136,89 +132,43 @@ pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (WIDTH, HEIGHT)).into_drawing_area();
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, (FONT, 26))
+            .caption(title, (FONT_FAMILY, 26))
             .margin(16)
             .x_label_area_size(45)
             .y_label_area_size(65)
             .build_cartesian_2d(0.0..x_max, 0.0..y_max)
-            .map_err(plot_error)?;
+            .map_err(draw_error(path))?;
         chart
             .configure_mesh()
             .x_desc(x_label)
             .y_desc(y_label)
-            .label_style((FONT, 15))
+            .label_style((FONT_FAMILY, 15))
             .x_labels(x_max as usize + 1)
             .x_label_formatter(&|x| format!("{x:.0}"))
             .draw()
-            .map_err(plot_error)?;
+            .map_err(draw_error(path))?;
         for (k, s) in series.iter().enumerate() {
             let colour = PALETTE[k % PALETTE.len()];
             chart
                 .draw_series(LineSeries::new(s.points.iter().copied(), colour.stroke_width(3)))
-                .map_err(plot_error)?
+                .map_err(draw_error(path))?
                 .label(s.label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3)));
-            chart.draw_series(s.points.iter().map(|&p| Circle::new(p, 5, colour.filled()))).map_err(plot_error)?;
+            chart
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+                .map_err(draw_error(path))?;
         }
         chart
             .configure_series_labels()
-            .label_font((FONT, 17))
+            .label_font((FONT_FAMILY, 17))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .position(SeriesLabelPosition::UpperRight)
             .draw()
-            .map_err(plot_error)?;
-        root.present().map_err(plot_error)?;
+            .map_err(draw_error(path))?;
+        root.present().map_err(draw_error(path))?;
     }
-    write_png(path, WIDTH, HEIGHT, &rgb).with_context(|| format!("{}: cannot write the chart", path.display()))
-}
-
-/// One picture of a gallery: a mesh coloured by per-element values.
-pub struct Tile<'m> {
-    pub title: String,
-    pub mesh: TileMesh<'m>,
-    pub values: Vec<f64>,
-}
-
-/// The mesh of a tile: drawn flat (2D), or as its boundary surface from a viewpoint (3D).
-pub enum TileMesh<'m> {
-    Flat(&'m Mesh2),
-    Solid(&'m Mesh3, View),
-}
-
-/// A grid of mesh pictures (rows of tiles), every tile on the same logarithmic colour range so
-/// the pictures compare.
-pub fn mesh_gallery(path: &Path, rows: &[Vec<Tile<'_>>], tile: (u32, u32)) -> anyhow::Result<()> {
-    let positive =
-        || rows.iter().flatten().flat_map(|t| t.values.iter().copied()).filter(|v| *v > 0.0 && v.is_finite());
-    let range = (positive().fold(f64::INFINITY, f64::min), positive().fold(0.0, f64::max));
-    let columns = rows.iter().map(Vec::len).max().unwrap_or(0) as u32;
-    let (width, height) = (tile.0 * columns.max(1), tile.1 * rows.len().max(1) as u32);
-    let mut rgb = vec![255u8; 3 * (width * height) as usize];
-    for (r, row) in rows.iter().enumerate() {
-        for (c, t) in row.iter().enumerate() {
-            let options = RenderOptions {
-                width: tile.0,
-                height: tile.1,
-                title: Some(t.title.clone()),
-                log_scale: true,
-                range: Some(range),
-                edges: true,
-            };
-            let image = match t.mesh {
-                TileMesh::Flat(mesh) => render_rgb(mesh, &t.values, &options),
-                TileMesh::Solid(mesh, view) => render_surface_rgb(mesh, &t.values, &options, view),
-            }
-            .map_err(|e| anyhow!("{}: {e}", t.title))?;
-            for y in 0..tile.1 as usize {
-                let src = &image[3 * y * tile.0 as usize..3 * (y + 1) * tile.0 as usize];
-                let dst_row = r * tile.1 as usize + y;
-                let dst = 3 * (dst_row * width as usize + c * tile.0 as usize);
-                rgb[dst..dst + src.len()].copy_from_slice(src);
-            }
-        }
-    }
-    write_png(path, width, height, &rgb).with_context(|| format!("{}: cannot write the gallery", path.display()))
+    write_png(path, WIDTH, HEIGHT, &rgb)
 }
 
 #[cfg(test)]
@@ -232,7 +182,7 @@ mod tests {
     }
 
     #[test]
-    fn charts_and_galleries_are_written_as_pngs() {
+    fn charts_are_written_as_pngs() {
         let dir = tempfile::tempdir().unwrap();
         let bars = vec![
             Bar { label: "amber-mean".into(), mean: 0.3, quantiles: [0.2, 0.4] },
@@ -248,10 +198,5 @@ mod tests {
         let series = Series { label: "amber-mean".into(), points: vec![(0.0, 1.0), (1.0, 0.5), (2.0, 0.3)] };
         line_chart(&path, "per step", "step", "normalised DCD", &[series]).unwrap();
         assert_eq!(decode(&path), (WIDTH, HEIGHT));
-        let mesh = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]], vec![0, 1, 2, 1, 3, 2]).unwrap();
-        let tile = |title: &str| Tile { title: title.into(), mesh: TileMesh::Flat(&mesh), values: mesh.sizes() };
-        let path = dir.path().join("gallery.png");
-        mesh_gallery(&path, &[vec![tile("a"), tile("b"), tile("c")], vec![tile("d")]], (200, 150)).unwrap();
-        assert_eq!(decode(&path), (600, 300));
     }
 }

@@ -7,16 +7,16 @@
 //! (painter's algorithm on the front-facing boundary triangles) and their edges are found in a
 //! buffer of which triangle each pixel shows, so hidden edges never show through.
 
-use std::io::Write;
 use std::path::Path;
-use std::sync::Once;
 
+use amber_mesh::{FacetAdjacency, Mesh2, Mesh3, MeshError, signed_volume};
 use plotters::prelude::{BitMapBackend, DrawingBackend, IntoFont, RGBColor};
+use plotters::style::TextStyle;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::style::{FontStyle, TextStyle};
 
-use crate::io::write_atomic;
-use crate::{FacetAdjacency, Mesh2, Mesh3, MeshError, signed_volume};
+use crate::error::draw_error;
+use crate::font::{FONT_FAMILY, register_default_font};
+use crate::{PlotError, write_png};
 
 /// How to draw a mesh picture.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,19 +53,9 @@ const EDGE_SHADE: f64 = 0.55;
 /// Element thickness (smallest height, in pixels) below which its edges are hidden, and above
 /// which they are drawn at full strength; in between they fade.
 const EDGE_FADE: (f64, f64) = (2.0, 8.0);
-const FONT_FAMILY: &str = "sans-serif";
-const MIN_SIZE: u32 = 64;
-const MAX_SIZE: u32 = 16_384;
-
-/// Registers the vendored DejaVu Sans as plotters' "sans-serif" font (once per process), so
-/// plotters charts anywhere in the program can draw text without system fonts.
-pub fn register_default_font() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        plotters::style::register_font(FONT_FAMILY, FontStyle::Normal, include_bytes!("../assets/DejaVuSans.ttf"))
-            .unwrap_or_else(|_| unreachable!("the vendored DejaVuSans.ttf is a valid font"));
-    });
-}
+/// Smallest and largest picture side, in pixels.
+pub(crate) const MIN_SIZE: u32 = 64;
+pub(crate) const MAX_SIZE: u32 = 16_384;
 
 /// Viridis at `t` in [0, 1]: Matt Zucker's degree-6 polynomial fit of matplotlib's table
 /// (shadertoy WlfXRN, CC0), within 3/255 of it.
@@ -91,42 +81,44 @@ pub fn viridis(t: f64) -> [u8; 3] {
 /// ratio. The file appears atomically.
 ///
 /// ```no_run
-/// # let mesh = amber_mesh::Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2])?;
-/// let options = amber_mesh::RenderOptions { title: Some("h".into()), log_scale: true, ..Default::default() };
-/// amber_mesh::render_png(&mesh, &mesh.sizes(), &options, "sizes.png")?;
-/// # Ok::<(), amber_mesh::MeshError>(())
+/// # let mesh = amber_mesh::Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2]).unwrap();
+/// let options = amber_plot::RenderOptions { title: Some("h".into()), log_scale: true, ..Default::default() };
+/// amber_plot::render_png(&mesh, &mesh.sizes(), &options, "sizes.png")?;
+/// # Ok::<(), amber_plot::PlotError>(())
 /// ```
 pub fn render_png(
     mesh: &Mesh2,
     values: &[f64],
     options: &RenderOptions,
     path: impl AsRef<Path>,
-) -> Result<(), MeshError> {
+) -> Result<(), PlotError> {
     let path = path.as_ref();
-    if values.len() != mesh.num_elements() {
-        return Err(MeshError::DataLength {
-            path: path.to_owned(),
-            field: "the rendered values".into(),
-            len: values.len(),
-            expected: mesh.num_elements(),
-        });
-    }
-    let image =
-        render_rgb(mesh, values, options).map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
+    let image = render_rgb(mesh, values, options, path)?;
     write_png(path, options.width, options.height, &image)
 }
 
-/// The picture [`render_png`] writes, as row-major RGB bytes (`3 × width × height`), for
-/// composing several meshes into one image; the error says what is wrong with the input.
-pub fn render_rgb(mesh: &Mesh2, values: &[f64], options: &RenderOptions) -> Result<Vec<u8>, String> {
-    if values.len() != mesh.num_elements() {
-        return Err(format!("{} rendered values for {} elements", values.len(), mesh.num_elements()));
+/// The picture [`render_png`] writes, as row-major RGB bytes (`3 × width × height`); errors name
+/// `path`, the file the picture is for.
+pub(crate) fn render_rgb(
+    mesh: &Mesh2,
+    values: &[f64],
+    options: &RenderOptions,
+    path: &Path,
+) -> Result<Vec<u8>, PlotError> {
+    check_request(mesh.num_elements(), values, options, path)?;
+    Ok(render(mesh, values, None, options, path)?.0)
+}
+
+/// Checks that there is one value per element and that the picture size is sensible.
+fn check_request(elements: usize, values: &[f64], options: &RenderOptions, path: &Path) -> Result<(), PlotError> {
+    if values.len() != elements {
+        return Err(PlotError::ValueCount { path: path.to_owned(), len: values.len(), expected: elements });
     }
-    let (w, h) = (options.width, options.height);
-    if !(MIN_SIZE..=MAX_SIZE).contains(&w) || !(MIN_SIZE..=MAX_SIZE).contains(&h) {
-        return Err(format!("image size {w}×{h} is outside {MIN_SIZE}..={MAX_SIZE} pixels per side"));
+    let (width, height) = (options.width, options.height);
+    if !(MIN_SIZE..=MAX_SIZE).contains(&width) || !(MIN_SIZE..=MAX_SIZE).contains(&height) {
+        return Err(PlotError::ImageSize { path: path.to_owned(), width, height });
     }
-    Ok(render(mesh, values, None, options)?.0)
+    Ok(())
 }
 
 /// Where the camera looks from, for pictures of 3D meshes: `azimuth_deg` around the z axis
@@ -137,43 +129,39 @@ pub struct View {
     pub elevation_deg: f64,
 }
 
-/// The picture of a tetrahedral mesh's boundary surface seen from `view`, each boundary
-/// triangle coloured by its tetrahedron's value and shaded by its angle to the light, as
-/// row-major RGB bytes (see [`render_rgb`]).
-pub fn render_surface_rgb(
+/// The picture [`render_surface_png`] writes, as row-major RGB bytes; errors name `path`, the
+/// file the picture is for.
+pub(crate) fn render_surface_rgb(
     mesh: &Mesh3,
     values: &[f64],
     options: &RenderOptions,
     view: View,
-) -> Result<Vec<u8>, String> {
-    if values.len() != mesh.num_elements() {
-        return Err(format!("{} rendered values for {} elements", values.len(), mesh.num_elements()));
-    }
-    let (w, h) = (options.width, options.height);
-    if !(MIN_SIZE..=MAX_SIZE).contains(&w) || !(MIN_SIZE..=MAX_SIZE).contains(&h) {
-        return Err(format!("image size {w}×{h} is outside {MIN_SIZE}..={MAX_SIZE} pixels per side"));
-    }
-    let (projected, face_values, shades) = visible_surface(mesh, values, view)?;
-    Ok(render(&projected, &face_values, Some(&shades), options)?.0)
+    path: &Path,
+) -> Result<Vec<u8>, PlotError> {
+    check_request(mesh.num_elements(), values, options, path)?;
+    let (projected, face_values, shades) =
+        visible_surface(mesh, values, view).map_err(|source| PlotError::Surface { path: path.to_owned(), source })?;
+    Ok(render(&projected, &face_values, Some(&shades), options, path)?.0)
 }
 
-/// Writes [`render_surface_rgb`]'s picture as a PNG file, atomically.
+/// Writes a PNG of a tetrahedral mesh's boundary surface seen from `view`, each boundary
+/// triangle coloured by its tetrahedron's value (as [`render_png`] colours elements) and shaded
+/// by its angle to the light. The file appears atomically.
 pub fn render_surface_png(
     mesh: &Mesh3,
     values: &[f64],
     options: &RenderOptions,
     view: View,
     path: impl AsRef<Path>,
-) -> Result<(), MeshError> {
+) -> Result<(), PlotError> {
     let path = path.as_ref();
-    let image = render_surface_rgb(mesh, values, options, view)
-        .map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
+    let image = render_surface_rgb(mesh, values, options, view, path)?;
     write_png(path, options.width, options.height, &image)
 }
 
 /// The front-facing boundary triangles of `mesh` projected onto the view plane, ordered back
 /// to front, with their tetrahedra's values and their shading factors in (0, 1].
-fn visible_surface(mesh: &Mesh3, values: &[f64], view: View) -> Result<(Mesh2, Vec<f64>, Vec<f64>), String> {
+fn visible_surface(mesh: &Mesh3, values: &[f64], view: View) -> Result<(Mesh2, Vec<f64>, Vec<f64>), MeshError> {
     let (az, el) = (view.azimuth_deg.to_radians(), view.elevation_deg.to_radians());
     let eye = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
     let right = [-az.sin(), az.cos(), 0.0];
@@ -183,7 +171,7 @@ fn visible_surface(mesh: &Mesh3, values: &[f64], view: View) -> Result<(Mesh2, V
         eye[1] + 0.4 * up[1] + 0.3 * right[1],
         eye[2] + 0.4 * up[2] + 0.3 * right[2],
     ]);
-    let adjacency = FacetAdjacency::new(mesh).map_err(|e| e.to_string())?;
+    let adjacency = FacetAdjacency::new(mesh)?;
     let vertices = mesh.vertices();
     let mut faces: Vec<(f64, [u32; 3], f64, f64)> = Vec::new();
     for (element, local) in adjacency.boundary_facets() {
@@ -209,7 +197,7 @@ fn visible_surface(mesh: &Mesh3, values: &[f64], view: View) -> Result<(Mesh2, V
     // Triangles seen edge-on have no area to draw (and are no valid 2D elements).
     faces.retain(|(_, t, _, _)| signed_volume::<2>(&points, t) > 1e-12 * extent * extent);
     let cells = faces.iter().flat_map(|f| f.1).collect();
-    let projected = Mesh2::new(points, cells).map_err(|e| e.to_string())?;
+    let projected = Mesh2::new(points, cells)?;
     Ok((projected, faces.iter().map(|f| f.2).collect(), faces.iter().map(|f| f.3).collect()))
 }
 
@@ -228,30 +216,6 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 fn normalised(a: [f64; 3]) -> [f64; 3] {
     let n = dot(a, a).sqrt().max(f64::MIN_POSITIVE);
     a.map(|x| x / n)
-}
-
-/// Writes row-major RGB bytes as a PNG file, atomically.
-pub fn write_png(path: impl AsRef<Path>, width: u32, height: u32, rgb: &[u8]) -> Result<(), MeshError> {
-    let path = path.as_ref();
-    if rgb.len() != 3 * width as usize * height as usize {
-        return Err(MeshError::Format {
-            path: path.to_owned(),
-            message: format!("{} bytes are not a {width}×{height} RGB image", rgb.len()),
-        });
-    }
-    write_atomic(path, |out| {
-        encode_png(out, width, height, rgb).map_err(|source| MeshError::Io { path: path.to_owned(), source })
-    })
-}
-
-fn encode_png(out: &mut impl Write, w: u32, h: u32, rgb: &[u8]) -> std::io::Result<()> {
-    let mut encoder = png::Encoder::new(out, w, h);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    encoder.set_compression(png::Compression::Fast);
-    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-    writer.write_image_data(rgb).map_err(std::io::Error::other)?;
-    writer.finish().map_err(std::io::Error::other)
 }
 
 /// Maps values to [0, 1] along the colour bar.
@@ -551,15 +515,16 @@ fn draw_surface(
     }
 }
 
-/// Draws the picture into an RGB buffer and says where the mesh went; errors are text-drawing
-/// failures. With `shades` (a projected surface, triangles back to front) each colour is
+/// Draws the picture for the file `path` into an RGB buffer and says where the mesh went; errors
+/// are text-drawing failures. With `shades` (a projected surface, triangles back to front) each colour is
 /// darkened by its triangle's factor and edges are drawn only where they are seen.
 fn render(
     mesh: &Mesh2,
     values: &[f64],
     shades: Option<&[f64]>,
     options: &RenderOptions,
-) -> Result<(Vec<u8>, Layout), String> {
+    path: &Path,
+) -> Result<(Vec<u8>, Layout), PlotError> {
     register_default_font();
     let (w, h) = (options.width, options.height);
     let scale = Scale::new(values, options);
@@ -576,7 +541,7 @@ fn render(
         let backend = BitMapBackend::with_buffer(&mut canvas.rgb, (w, h));
         let mut widest = 0;
         for (_, label) in &ticks {
-            widest = widest.max(backend.estimate_text_size(label, &label_style).map_err(|e| e.to_string())?.0);
+            widest = widest.max(backend.estimate_text_size(label, &label_style).map_err(draw_error(path))?.0);
         }
         widest as f64
     };
@@ -617,14 +582,14 @@ fn render(
     let mut backend = BitMapBackend::with_buffer(&mut canvas.rgb, (w, h));
     let label_x = (right + tick_length + 3) as i32;
     for (v, label) in &ticks {
-        backend.draw_text(label, &label_style, (label_x, tick_y(*v) as i32)).map_err(|e| e.to_string())?;
+        backend.draw_text(label, &label_style, (label_x, tick_y(*v) as i32)).map_err(draw_error(path))?;
     }
     if let Some(title) = &options.title {
         let style = text(layout.title_font, Pos::new(HPos::Center, VPos::Top));
         let y = (layout.title_font * 0.4) as i32;
-        backend.draw_text(title, &style, (w as i32 / 2, y)).map_err(|e| e.to_string())?;
+        backend.draw_text(title, &style, (w as i32 / 2, y)).map_err(draw_error(path))?;
     }
-    backend.present().map_err(|e| e.to_string())?;
+    backend.present().map_err(draw_error(path))?;
     drop(backend);
     Ok((canvas.rgb, layout))
 }
@@ -650,15 +615,15 @@ mod tests {
 
     #[test]
     fn element_centres_have_their_colour() {
-        let dir = crate::io::test_dir("render");
-        let path = dir.join("fan.png");
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("fan.png");
         let mesh = fan();
         let values = [1.0, 2.0, 3.0, f64::NAN];
         let options = RenderOptions { width: 400, height: 300, title: Some("fan".into()), ..Default::default() };
         render_png(&mesh, &values, &options, &path).unwrap();
         let (w, h, rgb) = decode(&path);
         assert_eq!((w, h), (400, 300));
-        let (_, layout) = render(&mesh, &values, None, &options).unwrap();
+        let (_, layout) = render(&mesh, &values, None, &options, &path).unwrap();
         for (e, expected) in [viridis(0.0), viridis(0.5), viridis(1.0), MISSING_COLOUR].into_iter().enumerate() {
             let [x, y] = layout.pixel(mesh.midpoint(e));
             let i = 3 * (y as usize * w as usize + x as usize);
@@ -668,7 +633,6 @@ mod tests {
         let [x0, y0] = layout.pixel([0.0, 0.0]);
         let [x1, y1] = layout.pixel([2.0, 1.0]);
         assert!(((x1 - x0) / (y0 - y1) - 2.0).abs() < 1e-12);
-        std::fs::remove_dir_all(dir).unwrap();
     }
 
     /// Two unit cubes of 6 tetrahedra each, at x ∈ [0, 1] (value 1) and x ∈ [3, 4] (value 2).
@@ -694,12 +658,13 @@ mod tests {
     fn surfaces_show_the_nearest_front_faces_shaded() {
         let (mesh, values) = two_cubes();
         let options = RenderOptions { width: 300, height: 200, edges: false, ..Default::default() };
+        let path = Path::new("cubes.png");
         let pixel = |view: View| {
-            let rgb = render_surface_rgb(&mesh, &values, &options, view).unwrap();
+            let rgb = render_surface_rgb(&mesh, &values, &options, view, path).unwrap();
             // The cubes' square outline is centred vertically; sample a pixel inside it.
             let (_, layout) = {
                 let (projected, v, s) = visible_surface(&mesh, &values, view).unwrap();
-                render(&projected, &v, Some(&s), &options).unwrap()
+                render(&projected, &v, Some(&s), &options, path).unwrap()
             };
             let [x, y] = layout.pixel([0.5 * if view.azimuth_deg == 0.0 { 1.0 } else { -1.0 }, 0.5]);
             let i = 3 * (y as usize * 300 + x as usize);
@@ -716,24 +681,27 @@ mod tests {
     #[test]
     fn surface_pictures_are_written_and_bad_requests_are_errors() {
         let (mesh, values) = two_cubes();
-        let dir = std::env::temp_dir().join(format!("amber-surface-{}", std::process::id()));
-        let path = dir.join("cubes.png");
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("cubes.png");
         let view = View { azimuth_deg: 30.0, elevation_deg: 25.0 };
         render_surface_png(&mesh, &values, &RenderOptions::default(), view, &path).unwrap();
         assert_eq!(decode(&path).0, 1000);
-        assert!(render_surface_rgb(&mesh, &values[1..], &RenderOptions::default(), view).is_err());
-        std::fs::remove_dir_all(dir).unwrap();
+        let err = render_surface_png(&mesh, &values[1..], &RenderOptions::default(), view, &path).unwrap_err();
+        assert!(matches!(err, PlotError::ValueCount { len: 11, expected: 12, .. }), "{err}");
+        assert!(err.to_string().contains("cubes.png"), "{err}");
     }
 
     #[test]
     fn bad_requests_are_errors() {
         let path = Path::new("/nonexistent-dir/x.png");
         let err = render_png(&fan(), &[1.0], &RenderOptions::default(), path).unwrap_err();
-        assert!(matches!(err, MeshError::DataLength { len: 1, expected: 4, .. }), "{err}");
+        assert!(matches!(err, PlotError::ValueCount { len: 1, expected: 4, .. }), "{err}");
         let tiny = RenderOptions { width: 10, ..Default::default() };
-        assert!(matches!(render_png(&fan(), &[1.0; 4], &tiny, path), Err(MeshError::Format { .. })));
-        assert!(matches!(render_png(&fan(), &[1.0; 4], &RenderOptions::default(), path), Err(MeshError::Io { .. })));
+        let err = render_png(&fan(), &[1.0; 4], &tiny, path).unwrap_err();
+        assert!(matches!(err, PlotError::ImageSize { width: 10, .. }), "{err}");
+        let err = render_png(&fan(), &[1.0; 4], &RenderOptions::default(), path).unwrap_err();
+        assert!(matches!(err, PlotError::Write(MeshError::Io { .. })), "{err}");
+        assert!(err.to_string().contains("x.png"), "{err}");
     }
 
     #[test]
