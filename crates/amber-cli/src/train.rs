@@ -8,7 +8,7 @@ use amber_mesh::{MeshData, write_mesh};
 use amber_plot::{RenderOptions, render_png};
 use amber_stdx::read_json;
 use amber_tasks::poisson::{Difficulty, read_problem};
-use amber_train::{AmberModel, Evaluation, MODEL_DIR, Profile, StepStatus};
+use amber_train::{AmberModel, Evaluation, MODEL_DIR, MethodConfig, Profile, StepStatus};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 
@@ -66,6 +66,8 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
         config.steps = steps;
     }
     let label = format!("{} {} seed {}", args.method, args.difficulty, args.seed);
+    let config = MethodConfig::Amber(config);
+    config.validate()?;
     let seconds = train_poisson(&config, args.difficulty, &args.data, &args.manifest, &args.out, &label)?;
     println!("trained in {seconds:.0} s; model in {}", args.out.join(MODEL_DIR).display());
     Ok(())
@@ -93,7 +95,7 @@ pub fn generate(args: GenerateArgs) -> anyhow::Result<()> {
     let problem = read_problem(&args.problem)?;
     let problems = [problem];
     let evaluation = Evaluation::new(&problems, &model.predictor.limits)?;
-    let (rollouts, summary) = evaluation.run(&model.network, &model.predictor, args.steps)?;
+    let (rollouts, summary) = evaluation.run(&model.sizing(), args.steps)?;
     let rollout = &rollouts[0];
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
     let range = rollout

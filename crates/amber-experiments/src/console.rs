@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use amber_mesh::Mesh3;
 use amber_plot::{Tile, TileMesh, View, mesh_gallery};
 use amber_tasks::console::{ConsoleProblem, ConsoleSplit, INITIAL_MESH_RECIPE, TrainSet, has_test_split, part_names};
-use amber_train::Profile;
+use amber_train::{MethodConfig, Profile};
 use anyhow::bail;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -17,7 +17,7 @@ use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::profiles::{Task, amber_config, cnn_config};
 use crate::results::ExperimentResults;
-use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
+use crate::run::{GALLERY_PROBLEMS, Run, evaluation_name, train_run};
 
 /// The two viewpoints of the galleries.
 const VIEWS: [View; 2] =
@@ -75,7 +75,7 @@ impl ConsoleExperiment {
 
     /// The configuration of one run: the Console task's profile (see [`amber_config`]), with the
     /// method's labels, the overrides and the seed.
-    pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<RunConfig> {
+    pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<MethodConfig> {
         Ok(match spec.method {
             Method::AmberMean | Method::AmberMax => {
                 let mut config = amber_config(Task::Console, self.profile);
@@ -83,7 +83,7 @@ impl ConsoleExperiment {
                 config.seed = seed as u64;
                 let config = spec.patched(&config, &self.overrides)?;
                 config.validate()?;
-                RunConfig::Amber(config)
+                MethodConfig::Amber(config)
             }
             Method::Cnn { resolution } => {
                 let mut config = cnn_config(Task::Console, self.profile, resolution);
@@ -91,7 +91,7 @@ impl ConsoleExperiment {
                 config.seed = seed as u64;
                 let config = spec.patched(&config, &self.cnn_overrides)?;
                 config.validate()?;
-                RunConfig::Cnn(config)
+                MethodConfig::Cnn(config)
             }
         })
     }
@@ -111,32 +111,27 @@ impl ConsoleExperiment {
         for seed in 0..self.seeds {
             for spec in &self.methods {
                 let config = self.run_config(spec, seed)?;
-                let data_key = (
-                    "data",
-                    serde_json::json!({
-                        "dir": self.data, "train_set": self.train_set, "initial_mesh": INITIAL_MESH_RECIPE,
-                    }),
-                );
-                let run =
-                    Run::new(&self.runs_root, "console", "console", spec, &config, data_key, &test_name, self.force)?;
-                let evaluated =
-                    run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| match &config {
-                        RunConfig::Amber(c) => {
-                            let problems = || {
-                                Ok((
-                                    self.load(ConsoleSplit::Train, c.data.train_problems)?,
-                                    self.load(ConsoleSplit::Val, c.data.val_problems)?,
-                                ))
-                            };
-                            train_amber(c, problems, dir, label)
-                        }
-                        RunConfig::Cnn(c) => {
-                            train_cnn(c, || self.load(ConsoleSplit::Train, c.data.train_problems), dir, label)
-                        }
-                    })?;
+                let data = serde_json::json!({
+                    "dir": self.data, "train_set": self.train_set, "initial_mesh": INITIAL_MESH_RECIPE,
+                });
+                let run = Run::new(&self.runs_root, "console", "console", spec, &config, data, &test_name);
+                if self.force {
+                    run.clear()?;
+                }
+                let evaluated = run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| {
+                    let problems = |validates: bool| {
+                        let val = if validates {
+                            self.load(ConsoleSplit::Val, config.data().val_problems)?
+                        } else {
+                            Vec::new()
+                        };
+                        Ok((self.load(ConsoleSplit::Train, config.data().train_problems)?, val))
+                    };
+                    train_run(&config, problems, dir, label)
+                })?;
                 configs.push(serde_json::json!({
                     "method": spec.method, "variant": spec.variant.name, "seed": seed, "run_dir": run.dir,
-                    "training": config.to_json()?,
+                    "training": config,
                 }));
                 runs.push(evaluated.result(spec, "console", seed));
                 if seed == 0 && spec.variant.name == "default" {

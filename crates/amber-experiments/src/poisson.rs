@@ -10,7 +10,7 @@ use amber_stdx::read_json;
 use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
 use amber_tasks::poisson::{Difficulty, PoissonProblem, Split, load_split, read_split};
-use amber_train::{Profile, TrainingConfig};
+use amber_train::{MethodConfig, Profile};
 use anyhow::bail;
 use serde::Serialize;
 
@@ -20,7 +20,7 @@ use crate::profiles::{Task, amber_config, cnn_config};
 use crate::progress::item_bar;
 use crate::report::merge_json;
 use crate::results::ExperimentResults;
-use crate::run::{GALLERY_PROBLEMS, Run, RunConfig, evaluation_name, train_amber, train_cnn};
+use crate::run::{GALLERY_PROBLEMS, Run, evaluation_name, train_run};
 
 /// Everything an invocation of the Poisson experiment decides.
 #[derive(Clone, Debug, Serialize)]
@@ -155,7 +155,7 @@ impl PoissonExperiment {
 
     /// The configuration of one run: the profile's, with the method's labels, the variant's and
     /// the user's overrides (AMBER runs: `overrides`, CNN runs: `cnn_overrides`) and the seed.
-    pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<RunConfig> {
+    pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<MethodConfig> {
         Ok(match spec.method {
             Method::AmberMean | Method::AmberMax => {
                 let mut config = amber_config(Task::Poisson, self.profile);
@@ -163,7 +163,7 @@ impl PoissonExperiment {
                 config.seed = seed as u64;
                 let config = spec.patched(&config, &self.overrides)?;
                 config.validate()?;
-                RunConfig::Amber(config)
+                MethodConfig::Amber(config)
             }
             Method::Cnn { resolution } => {
                 let mut config = cnn_config(Task::Poisson, self.profile, resolution);
@@ -171,7 +171,7 @@ impl PoissonExperiment {
                 config.seed = seed as u64;
                 let config = spec.patched(&config, &self.cnn_overrides)?;
                 config.validate()?;
-                RunConfig::Cnn(config)
+                MethodConfig::Cnn(config)
             }
         })
     }
@@ -192,30 +192,17 @@ impl PoissonExperiment {
             for seed in 0..self.seeds {
                 for spec in &self.methods {
                     let config = self.run_config(spec, seed)?;
-                    let data_key = ("data", serde_json::json!({ "manifest": manifest, "difficulty": difficulty }));
-                    let run = Run::new(
-                        &self.runs_root,
-                        "poisson",
-                        difficulty.name(),
-                        spec,
-                        &config,
-                        data_key,
-                        &test_name,
-                        self.force,
-                    )?;
-                    let evaluated =
-                        run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| match &config {
-                            RunConfig::Amber(c) => {
-                                train_poisson(c, difficulty, &self.data_root, &self.manifest, dir, label)
-                            }
-                            RunConfig::Cnn(c) => {
-                                let train = || self.load(difficulty, Split::Train, seed, c.data.train_problems);
-                                train_cnn(c, train, dir, label)
-                            }
-                        })?;
+                    let data = serde_json::json!({ "manifest": manifest, "difficulty": difficulty });
+                    let run = Run::new(&self.runs_root, "poisson", difficulty.name(), spec, &config, data, &test_name);
+                    if self.force {
+                        run.clear()?;
+                    }
+                    let evaluated = run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| {
+                        train_poisson(&config, difficulty, &self.data_root, &self.manifest, dir, label)
+                    })?;
                     configs.push(serde_json::json!({
                         "method": spec.method, "variant": spec.variant.name, "difficulty": difficulty.name(),
-                        "seed": seed, "run_dir": run.dir, "training": config.to_json()?,
+                        "seed": seed, "run_dir": run.dir, "training": config,
                     }));
                     runs.push(evaluated.result(spec, difficulty.name(), seed));
                     if seed == 0 && spec.variant.name == "default" {
@@ -300,25 +287,29 @@ fn paper_number(row: &str, difficulty: &str) -> Option<f64> {
     })
 }
 
-/// Trains AMBER on the Poisson task into `dir` until the config's last step (see
-/// [`train_amber`]), generating the training and validation problems the config names under
+/// Trains a method on the Poisson task into `dir` until the config's last step (see
+/// [`train_run`]), generating the training and validation problems the config names under
 /// `data_root` first where missing. Returns the training wall time; `label` names the run in
 /// progress lines.
 pub fn train_poisson(
-    config: &TrainingConfig,
+    config: &MethodConfig,
     difficulty: Difficulty,
     data_root: &Path,
     manifest: &Path,
     dir: &Path,
     label: &str,
 ) -> anyhow::Result<f64> {
-    let seed = config.seed as usize;
-    let problems = || {
-        let train = load_problems(data_root, manifest, difficulty, Split::Train, seed, config.data.train_problems)?;
-        let val = load_problems(data_root, manifest, difficulty, Split::Val, 0, config.data.val_problems)?;
+    let (seed, data) = (config.seed() as usize, config.data());
+    let problems = |validates: bool| {
+        let train = load_problems(data_root, manifest, difficulty, Split::Train, seed, data.train_problems)?;
+        let val = if validates {
+            load_problems(data_root, manifest, difficulty, Split::Val, 0, data.val_problems)?
+        } else {
+            Vec::new()
+        };
         Ok((train, val))
     };
-    train_amber(config, problems, dir, label)
+    train_run(config, problems, dir, label)
 }
 
 /// The first `count` problems of a split, generated first where missing (with a progress bar).

@@ -47,6 +47,11 @@ impl TrainingProgress {
         if self.bar.is_hidden() { eprintln!("{line}") } else { self.bar.println(line) }
     }
 
+    /// Moves the bar to `done` steps (a run that resumed there).
+    pub fn set_position(&self, done: u64) {
+        self.bar.set_position(done);
+    }
+
     /// Removes the bar, leaving the printed lines.
     pub fn finish(&self) {
         self.bar.finish_and_clear();

@@ -7,10 +7,11 @@ use std::time::Instant;
 
 use amber_mesh::{Mesh, MeshData, read_mesh, write_mesh};
 use amber_stdx::read_json;
+use amber_tasks::MeshLimits;
 use amber_tasks::Problem;
 use amber_train::{
-    AmberModel, CONFIG_FILE, CnnConfig, CnnModel, CnnObserver, CnnStepReport, CnnTraining, Evaluation,
-    EvaluationSummary, MODEL_DIR, Rollout, StepReport, Training, TrainingConfig, TrainingObserver,
+    CONFIG_FILE, CnnObserver, CnnStepReport, Evaluation, EvaluationSummary, MODEL_DIR, MethodConfig, Rollout,
+    StepReport, TrainedModel, TrainingObserver,
 };
 use anyhow::{Context, bail};
 use serde::{Deserialize, Serialize};
@@ -25,46 +26,6 @@ pub(crate) const GALLERY_PROBLEMS: usize = 2;
 
 /// Where a run directory records its training wall time.
 const TIME_FILE: &str = "training_time.json";
-
-/// The configuration of one run of either kind of method.
-#[derive(Clone, Debug, PartialEq)]
-pub enum RunConfig {
-    Amber(TrainingConfig),
-    Cnn(CnnConfig),
-}
-
-impl RunConfig {
-    /// Generation steps of the method's rollouts (the CNN predicts once).
-    pub fn inference_steps(&self) -> usize {
-        match self {
-            RunConfig::Amber(c) => c.inference_steps,
-            RunConfig::Cnn(_) => 1,
-        }
-    }
-
-    pub fn seed(&self) -> u64 {
-        match self {
-            RunConfig::Amber(c) => c.seed,
-            RunConfig::Cnn(c) => c.seed,
-        }
-    }
-
-    /// The config as JSON, tagged with its kind.
-    pub fn to_json(&self) -> anyhow::Result<serde_json::Value> {
-        Ok(match self {
-            RunConfig::Amber(c) => serde_json::json!({ "amber": c }),
-            RunConfig::Cnn(c) => serde_json::json!({ "cnn": c }),
-        })
-    }
-
-    /// The config as JSON, untagged (what the run directory's hash covers).
-    fn untagged(&self) -> anyhow::Result<serde_json::Value> {
-        Ok(match self {
-            RunConfig::Amber(c) => serde_json::to_value(c)?,
-            RunConfig::Cnn(c) => serde_json::to_value(c)?,
-        })
-    }
-}
 
 /// The name an evaluation is cached under: the test set's, and how over-budget fields are
 /// treated when they are scaled.
@@ -97,7 +58,7 @@ impl CachedEvaluation {
 }
 
 /// A run directory: `<runs>/<task>/<setting>/<method>[-<variant>]/seed<r>-<hash>`, where the
-/// hash covers the config and `data_key` (what identifies the training data).
+/// hash covers the config and `data` (what identifies the training data).
 pub(crate) struct Run {
     pub dir: PathBuf,
     pub label: String,
@@ -111,26 +72,30 @@ impl Run {
         task: &str,
         setting: &str,
         spec: &MethodSpec,
-        config: &RunConfig,
-        data_key: (&str, serde_json::Value),
+        config: &MethodConfig,
+        data: serde_json::Value,
         test_name: &str,
-        force: bool,
-    ) -> anyhow::Result<Self> {
+    ) -> Self {
         let name = match spec.variant.name.as_str() {
             "default" => spec.method.name(),
             variant => format!("{}-{variant}", spec.method.name()),
         };
-        let mut key = serde_json::json!({ "config": config.untagged()? });
-        key[data_key.0] = data_key.1;
+        let key = serde_json::json!({ "config": config.to_json(), "data": data });
         let dir =
             runs_root.join(task).join(setting).join(&name).join(format!("seed{}-{}", config.seed(), config_hash(&key)));
-        if force && dir.exists() {
-            std::fs::remove_dir_all(&dir).with_context(|| format!("{}: cannot remove for --force", dir.display()))?;
-        }
         // Evaluations are keyed by the test set and how it is evaluated.
         let eval_dir = dir.join(format!("eval-{}", config_hash(&serde_json::json!(test_name))));
         let label = format!("{} {setting} seed {}", spec.label(), config.seed());
-        Ok(Self { dir, label, test_name: test_name.into(), eval_dir })
+        Self { dir, label, test_name: test_name.into(), eval_dir }
+    }
+
+    /// Deletes what the run directory holds, so that the run is trained and evaluated afresh.
+    pub fn clear(&self) -> anyhow::Result<()> {
+        if self.dir.exists() {
+            std::fs::remove_dir_all(&self.dir)
+                .with_context(|| format!("{}: cannot remove for --force", self.dir.display()))?;
+        }
+        Ok(())
     }
 
     /// Trains the run with `train` (which must resume or reuse what `dir` holds; it returns the
@@ -139,7 +104,7 @@ impl Run {
     /// evaluation skips both.
     pub fn train_and_evaluate<const D: usize, P: Problem<D>>(
         &self,
-        config: &RunConfig,
+        config: &MethodConfig,
         test: &[P],
         scale_to_budget: bool,
         train: impl FnOnce(&Path, &str) -> anyhow::Result<f64>,
@@ -152,20 +117,10 @@ impl Run {
         }
         let train_seconds = train(&self.dir, &self.label)?;
         let started = Instant::now();
-        let rollouts = match config {
-            RunConfig::Amber(config) => {
-                let mut model = AmberModel::load(&self.dir.join(MODEL_DIR))?;
-                model.predictor.limits.scale_to_budget = scale_to_budget;
-                let evaluation = Evaluation::new(test, &model.predictor.limits)?;
-                evaluation.run(&model.network, &model.predictor, config.inference_steps)?.0
-            }
-            RunConfig::Cnn(_) => {
-                let mut model = CnnModel::load(&self.dir.join(MODEL_DIR))?;
-                model.predictor.limits.scale_to_budget = scale_to_budget;
-                let references = Evaluation::new(test, &model.predictor.limits)?.references;
-                model.rollouts(test, &references)?
-            }
-        };
+        let mut model = TrainedModel::load(&self.dir.join(MODEL_DIR))?;
+        model.limits_mut().scale_to_budget = scale_to_budget;
+        let evaluation = Evaluation::new(test, model.limits())?;
+        let rollouts = model.rollouts(&evaluation, config.inference_steps())?;
         let eval_seconds = started.elapsed().as_secs_f64();
         let problems: Vec<ProblemEvaluation> =
             rollouts.iter().zip(test).map(|(r, p)| ProblemEvaluation::of(r, p.expert_mesh().num_elements())).collect();
@@ -216,50 +171,34 @@ impl Run {
     }
 }
 
-/// Trains AMBER into `dir` until the config's last step: resumes from the newest checkpoint in
-/// `dir`, validates on the validation problems as configured, writes the model to `dir/model`.
-/// A finished run of the same config is not retrained (and `problems` is not called). Returns
-/// the training wall time, summed over resumed sessions; `label` names the run in progress
-/// lines. `problems` gives the training and validation problems.
-pub fn train_amber<const D: usize, P: Problem<D>>(
-    config: &TrainingConfig,
-    problems: impl FnOnce() -> anyhow::Result<(Vec<P>, Vec<P>)>,
+/// Trains the run of `config` into `dir` until its last step: resumes from the newest checkpoint
+/// in `dir`, validates (AMBER) on the validation problems as configured, writes the model to
+/// `dir/model`. A finished run of the same config is not retrained (and `problems` is not
+/// called). Returns the training wall time, summed over resumed sessions; `label` names the run
+/// in progress lines. `problems` gives the training and, when the method validates, the
+/// validation problems (it is told whether to load them).
+pub fn train_run<const D: usize, P: Problem<D>>(
+    config: &MethodConfig,
+    problems: impl FnOnce(bool) -> anyhow::Result<(Vec<P>, Vec<P>)>,
     dir: &Path,
     label: &str,
 ) -> anyhow::Result<f64> {
     if let Some(seconds) = finished_run(dir, config)? {
         return Ok(seconds);
     }
-    let (train, val) = problems()?;
-    let mut training = Training::open(config.clone(), train, dir)?;
-    let validation = Evaluation::new(&val, training.limits())?;
-    let mut progress = TimedProgress::start(dir, label, training.step(), config.steps)?;
-    progress.inner.println(&format!(
-        "{} at step {} in {}: h_min {:.3e}, budget {} elements",
-        if training.step() > 0 { "resumed" } else { "training" },
-        training.step(),
-        dir.display(),
-        training.limits().min_size,
-        training.limits().max_elements
-    ));
-    training.run(dir, Some(&validation), &mut progress)?;
-    progress.finish()
-}
-
-/// Trains the U-Net baseline into `dir` (as [`train_amber`] does AMBER): resumable, not
-/// retrained once finished; returns the training wall time.
-pub fn train_cnn<const D: usize, P: Problem<D>>(
-    config: &CnnConfig,
-    problems: impl FnOnce() -> anyhow::Result<Vec<P>>,
-    dir: &Path,
-    label: &str,
-) -> anyhow::Result<f64> {
-    if let Some(seconds) = finished_run(dir, config)? {
-        return Ok(seconds);
-    }
-    let mut training = CnnTraining::open(config.clone(), problems()?, dir)?;
-    let mut progress = TimedProgress::start(dir, label, training.step(), config.steps)?;
-    training.run(dir, &mut progress)?;
+    let (train, val) = problems(config.validates())?;
+    let mut progress = TimedProgress::start(dir, label, config.steps())?;
+    let announce = |step: u64, limits: &MeshLimits, progress: &mut TimedProgress| {
+        progress.resume_at(step);
+        progress.inner.println(&format!(
+            "{} at step {step} in {}: h_min {:.3e}, budget {} elements",
+            if step > 0 { "resumed" } else { "training" },
+            dir.display(),
+            limits.min_size,
+            limits.max_elements
+        ));
+    };
+    config.train(train, &val, dir, &mut progress, announce)?;
     progress.finish()
 }
 
@@ -272,13 +211,13 @@ struct TrainingTime {
 
 /// The training time of `dir` if it holds a finished run of `config`; an error if it holds a
 /// finished run of another configuration.
-fn finished_run<C: PartialEq + serde::de::DeserializeOwned>(dir: &Path, config: &C) -> anyhow::Result<Option<f64>> {
+fn finished_run(dir: &Path, config: &MethodConfig) -> anyhow::Result<Option<f64>> {
     let time_path = dir.join(TIME_FILE);
     let time: TrainingTime = if time_path.exists() { read_json(&time_path)? } else { TrainingTime::default() };
     if !(time.finished && dir.join(MODEL_DIR).exists()) {
         return Ok(None);
     }
-    if read_json::<C>(&dir.join(CONFIG_FILE))? != *config {
+    if read_json::<serde_json::Value>(&dir.join(CONFIG_FILE))? != config.to_json() {
         bail!(
             "{}: holds a finished run with another configuration; train into a new directory or delete it",
             dir.display()
@@ -297,12 +236,17 @@ struct TimedProgress {
 }
 
 impl TimedProgress {
-    /// Progress of the run in `dir` standing at step `done` of `total`, its clock continuing
-    /// from the time recorded there.
-    fn start(dir: &Path, label: &str, done: u64, total: u64) -> anyhow::Result<Self> {
+    /// Progress of the run in `dir` of `total` steps, its clock continuing from the time
+    /// recorded there.
+    fn start(dir: &Path, label: &str, total: u64) -> anyhow::Result<Self> {
         let time_path = dir.join(TIME_FILE);
         let before = if time_path.exists() { read_json::<TrainingTime>(&time_path)?.seconds } else { 0.0 };
-        Ok(Self { inner: TrainingProgress::new(label, done, total), time_path, before, started: Instant::now() })
+        Ok(Self { inner: TrainingProgress::new(label, 0, total), time_path, before, started: Instant::now() })
+    }
+
+    /// The run stands at step `done` (it resumed there).
+    fn resume_at(&self, done: u64) {
+        self.inner.set_position(done);
     }
 
     fn seconds(&self) -> f64 {

@@ -1,46 +1,11 @@
-//! The one place for every knob of a training run, and the named profiles (`smoke`, `quick`,
-//! `paper`). A run's config is written beside its results so each number traces to its settings.
+//! What the configurations of both methods share: the named profiles (`smoke`, `quick`,
+//! `paper`), how many problems a run reads, and the learning-rate schedule. A run's config is
+//! written beside its results so each number traces to its settings.
 
 use std::fmt;
 use std::str::FromStr;
 
-use amber_graph::Aggregation;
 use serde::{Deserialize, Serialize};
-
-use crate::error::{Result, TrainError};
-
-/// What the network's scalar output `z` means and which loss trains it (spec §5, §11).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Objective {
-    /// The paper: size = softplus(z), MSE against the raw label sizes.
-    Softplus,
-    /// size = z, MSE against the raw sizes (the "no softplus" ablation).
-    Linear,
-    /// size = exp(z'), MSE of z against log sizes (the CNN's loss).
-    Log,
-    /// The later version (§11.3): size = softplus(z' + softplus⁻¹(h)), h the current element's
-    /// size; MSE of z against the label's residual softplus⁻¹(y) − softplus⁻¹(h).
-    SoftplusResidual,
-}
-
-impl Objective {
-    /// Whether `z` lives in an unbounded space where label normalisation applies: there `z'` is
-    /// `z` de-normalised with the running label moments.
-    pub fn supports_label_normalisation(self) -> bool {
-        matches!(self, Objective::Log | Objective::SoftplusResidual)
-    }
-}
-
-/// How the source of a new buffer entry is chosen (spec §6, reference notes §6.2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SourceSelection {
-    /// A depth uniformly among the depths present (≤ the maximum), then an entry of that depth.
-    Stratified,
-    /// An entry uniformly among all entries of allowed depth (the "random additions" ablation).
-    Uniform,
-}
 
 /// Learning-rate schedule over the whole run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -70,28 +35,6 @@ impl LrSchedule {
     }
 }
 
-/// Size of the message passing network; the feature widths come from the task.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct NetworkConfig {
-    /// Latent width D (Poisson 64, Console 128).
-    pub latent_dim: usize,
-    /// Message-passing steps L.
-    pub message_passing_steps: usize,
-    /// Edge dropout probability during training.
-    pub edge_dropout: f64,
-    /// The graph context of `amber_mpn::MpnConfig::graph_context` (not in the paper); omitted
-    /// from the JSON when off, so configurations without it keep their hashes.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub graph_context: bool,
-}
-
-impl Default for NetworkConfig {
-    fn default() -> Self {
-        Self { latent_dim: 64, message_passing_steps: 10, edge_dropout: 0.1, graph_context: false }
-    }
-}
-
 /// How many of a task's problems a run reads (which task and files is the caller's to say; the
 /// loops themselves take problems, not paths).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -109,202 +52,8 @@ impl Default for DataConfig {
     }
 }
 
-/// Every knob of a training run. Defaults are the `quick` profile.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct TrainingConfig {
-    /// Seeds the network initialisation, edge dropout and buffer sampling.
-    pub seed: u64,
-    /// Data the run reads.
-    pub data: DataConfig,
-    /// AMBER-Mean or AMBER-Max labels (spec §3).
-    pub aggregation: Aggregation,
-    /// Output transform and loss.
-    pub objective: Objective,
-    /// Normalise the training targets by their running moments (only for objectives with
-    /// unbounded output, see [`Objective::supports_label_normalisation`]).
-    pub normalise_labels: bool,
-    /// Normalise node and edge features by their running moments (off: the ablation).
-    pub normalise_inputs: bool,
-    /// Extra node inputs appended in order to the task's features, by column name: `log_size`
-    /// (log h(K), any task) or one of the task's optional inputs
-    /// (`amber_tasks::Problem::optional_inputs`); none in the paper.
-    pub inputs: Vec<String>,
-    /// The network.
-    pub network: NetworkConfig,
-    /// Gradient steps.
-    pub steps: u64,
-    /// Peak Adam learning rate.
-    pub learning_rate: f64,
-    /// Learning-rate schedule.
-    pub lr_schedule: LrSchedule,
-    /// Global gradient-norm clip.
-    pub max_grad_norm: Option<f64>,
-    /// Node budget of one batch (least-used graphs first, stop at the first that does not fit).
-    pub batch_nodes: usize,
-    /// Generated meshes kept in the FIFO part of the buffer (protected entries not counted).
-    pub buffer_capacity: usize,
-    /// One new buffer entry after every `add_interval` gradient steps.
-    pub add_interval: u64,
-    /// Deepest entry used as the source of a new entry (new entries get source depth + 1).
-    pub max_source_depth: usize,
-    /// How the source entry is chosen.
-    pub source_selection: SourceSelection,
-    /// Element budget = `budget_factor` × the largest training expert mesh.
-    pub budget_factor: f64,
-    /// Predicted sizes are clipped below at this quantile of all training expert element sizes
-    /// (0: the minimum, as for Poisson; the Console task uses 0.005).
-    pub min_size_quantile: f64,
-    /// Generation steps T of a rollout (validation and inference).
-    pub inference_steps: usize,
-    /// Write a checkpoint every this many steps (and at the end).
-    pub checkpoint_interval: u64,
-    /// Roll out the validation problems every this many steps (and at the end); 0: never.
-    pub validation_interval: u64,
-}
-
-impl Default for TrainingConfig {
-    fn default() -> Self {
-        Self::quick()
-    }
-}
-
-impl TrainingConfig {
-    /// The paper's settings (spec §5, §6): Poisson hard, AMBER-Mean, softplus output with MSE on
-    /// raw sizes, constant Adam 3e-4, clip 0.5, 400,000-node batches, 1,000-entry buffer with an
-    /// addition every 8 steps, 128,000 steps, validation every 256-step iteration. Meant for a GPU
-    /// (this crate runs on the CPU today).
-    pub fn paper() -> Self {
-        Self {
-            seed: 0,
-            data: DataConfig::default(),
-            aggregation: Aggregation::Mean,
-            objective: Objective::Softplus,
-            normalise_labels: false,
-            normalise_inputs: true,
-            inputs: Vec::new(),
-            network: NetworkConfig::default(),
-            steps: 128_000,
-            learning_rate: 3e-4,
-            lr_schedule: LrSchedule::Constant,
-            max_grad_norm: Some(0.5),
-            batch_nodes: 400_000,
-            buffer_capacity: 1_000,
-            add_interval: 8,
-            max_source_depth: 4,
-            source_selection: SourceSelection::Stratified,
-            budget_factor: 1.2,
-            min_size_quantile: 0.0,
-            inference_steps: 5,
-            checkpoint_interval: 2_560,
-            validation_interval: 2_560,
-        }
-    }
-
-    /// The default: the best quality reachable within about 30 minutes of training per variant
-    /// on two CPU cores. The later version's levers (§11): residual in softplus space with
-    /// normalised labels, learning rate 1e-3 with 5 % warm-up and linear decay; plus the log-size
-    /// input and the network's graph context. Small batches (12,000 nodes, about one generated
-    /// mesh) so that many steps fit, an addition every 4 steps so the buffer fills with the
-    /// model's own meshes early, a 500-entry buffer. Tasks adjust it (amber-experiments'
-    /// profile table); the evidence is in docs/PROFILES.md.
-    pub fn quick() -> Self {
-        Self {
-            objective: Objective::SoftplusResidual,
-            normalise_labels: true,
-            inputs: vec![amber_tasks::LOG_SIZE_COLUMN.into()],
-            network: NetworkConfig { graph_context: true, ..NetworkConfig::default() },
-            steps: 2_500,
-            learning_rate: 1e-3,
-            lr_schedule: LrSchedule::WarmupLinearDecay { warmup_fraction: 0.05 },
-            batch_nodes: 12_000,
-            buffer_capacity: 500,
-            add_interval: 4,
-            checkpoint_interval: 250,
-            validation_interval: 1_250,
-            ..Self::paper()
-        }
-    }
-
-    /// For CI: two easy training problems, a small network and a few hundred steps; every part
-    /// of the loop (additions, eviction, checkpoints, validation) runs at least once.
-    pub fn smoke() -> Self {
-        Self {
-            data: DataConfig { train_problems: 2, val_problems: 2 },
-            network: NetworkConfig { latent_dim: 32, message_passing_steps: 4, ..Self::quick().network },
-            steps: 200,
-            batch_nodes: 4_000,
-            buffer_capacity: 20,
-            add_interval: 4,
-            checkpoint_interval: 100,
-            validation_interval: 100,
-            inference_steps: 3,
-            ..Self::quick()
-        }
-    }
-
-    /// The config of a named profile.
-    pub fn profile(profile: Profile) -> Self {
-        match profile {
-            Profile::Smoke => Self::smoke(),
-            Profile::Quick => Self::quick(),
-            Profile::Paper => Self::paper(),
-        }
-    }
-
-    /// Checks ranges and combinations; the message names the field.
-    pub fn validate(&self) -> Result<()> {
-        let bad = |m: &str| Err(TrainError::InvalidConfig(m.to_owned()));
-        if self.steps == 0 {
-            return bad("steps must be positive");
-        }
-        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
-            return bad("learning_rate must be positive");
-        }
-        if let LrSchedule::WarmupLinearDecay { warmup_fraction } = self.lr_schedule
-            && !(0.0..1.0).contains(&warmup_fraction)
-        {
-            return bad("lr_schedule.warmup_fraction must be in [0, 1)");
-        }
-        if self.max_grad_norm.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
-            return bad("max_grad_norm must be positive");
-        }
-        if self.batch_nodes == 0 || self.add_interval == 0 || self.checkpoint_interval == 0 {
-            return bad("batch_nodes, add_interval and checkpoint_interval must be positive");
-        }
-        if !(self.budget_factor.is_finite() && self.budget_factor > 0.0) {
-            return bad("budget_factor must be positive");
-        }
-        if !(0.0..=1.0).contains(&self.min_size_quantile) {
-            return bad("min_size_quantile must be in [0, 1]");
-        }
-        if self.normalise_labels && !self.objective.supports_label_normalisation() {
-            return bad("normalise_labels needs objective log or softplus_residual");
-        }
-        if self.network.latent_dim == 0 || !(0.0..1.0).contains(&self.network.edge_dropout) {
-            return bad("network.latent_dim must be positive and network.edge_dropout in [0, 1)");
-        }
-        if self.data.train_problems == 0 {
-            return bad("data.train_problems must be positive");
-        }
-        // Upper bounds that a machine can hold, so that a typo is an error, not an abort.
-        let limits: [(&str, u64, u64); 7] = [
-            ("network.latent_dim", self.network.latent_dim as u64, 4_096),
-            ("network.message_passing_steps", self.network.message_passing_steps as u64, 256),
-            ("batch_nodes", self.batch_nodes as u64, 100_000_000),
-            ("buffer_capacity", self.buffer_capacity as u64, 1_000_000),
-            ("data.train_problems", self.data.train_problems as u64, 1_000_000),
-            ("data.val_problems", self.data.val_problems as u64, 1_000_000),
-            ("inference_steps", self.inference_steps as u64, 10_000),
-        ];
-        if let Some((field, value, max)) = limits.into_iter().find(|&(_, value, max)| value > max) {
-            return Err(TrainError::InvalidConfig(format!("{field} is {value}, at most {max} is supported")));
-        }
-        Ok(())
-    }
-}
-
-/// A named profile of [`TrainingConfig`].
+/// A named profile: the settings of `smoke` (CI), `quick` (two CPU cores) or `paper` (GPU
+/// scale) of every method's config.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Profile {
@@ -350,29 +99,6 @@ impl FromStr for Profile {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn profiles_are_valid_and_round_trip_through_json() {
-        for profile in Profile::ALL {
-            let config = TrainingConfig::profile(profile);
-            config.validate().unwrap();
-            let json = serde_json::to_string(&config).unwrap();
-            assert_eq!(serde_json::from_str::<TrainingConfig>(&json).unwrap(), config);
-            assert_eq!(profile.name().parse::<Profile>().unwrap(), profile);
-        }
-        let partial: TrainingConfig = serde_json::from_str(r#"{"steps": 10, "aggregation": "max"}"#).unwrap();
-        let expected = TrainingConfig { steps: 10, aggregation: Aggregation::Max, ..TrainingConfig::quick() };
-        assert_eq!(partial, expected, "absent fields are the quick profile's");
-        assert!(serde_json::from_str::<TrainingConfig>(r#"{"stepz": 10}"#).is_err());
-        let bad = TrainingConfig { objective: Objective::Softplus, normalise_labels: true, ..TrainingConfig::quick() };
-        assert!(bad.validate().is_err());
-        let huge = TrainingConfig {
-            network: NetworkConfig { latent_dim: 1_000_000_000, ..NetworkConfig::default() },
-            ..TrainingConfig::quick()
-        };
-        let message = huge.validate().unwrap_err().to_string();
-        assert!(message.contains("network.latent_dim") && message.contains("4096"), "{message}");
-    }
 
     #[test]
     fn warmup_rises_linearly_then_decays_to_zero() {

@@ -1,7 +1,10 @@
-//! AMBER's training and inference loops, for any task (`amber_tasks::Problem`): the replay buffer with least-used batching
-//! and stratified additions, running input and label normalisation, the training loop with
-//! checkpoints that resume exactly and a JSON-lines log, and rollouts of a trained model with
-//! their metrics against the expert.
+//! The two methods' training and inference loops, for any task (`amber_tasks::Problem`): AMBER
+//! (`amber`: the replay buffer with least-used batching and stratified additions, running input
+//! and label normalisation, the training loop with a JSON-lines log) and the U-Net baseline
+//! (`cnn`), over what they share: checkpoints that resume exactly, one rollout loop with its
+//! metrics against the expert ([`rollouts`], for any [`SizingModel`]), and the method as one
+//! configuration or one trained model ([`MethodConfig`], [`TrainedModel`]). Never sees a tensor:
+//! the networks' crates take and return plain slices.
 //!
 //! Configuration is one typed struct ([`TrainingConfig`]) with named profiles. The crate never
 //! prints: progress goes through [`TrainingObserver`]; argument parsing and plotting belong to the
@@ -12,27 +15,28 @@
 //! network's parallel gradient reductions sum in a scheduling-dependent order, so runs agree only
 //! to rounding at first and then drift apart.
 
-mod buffer;
+mod amber;
 mod checkpoint;
 mod cnn;
 mod config;
 mod error;
-mod inference;
-mod model;
-mod target;
-mod train;
+mod method;
+mod rollout;
 
-pub use buffer::{BufferEntry, ReplayBuffer, Sample};
+pub use amber::{
+    Addition, AmberModel, AmberSizing, BufferEntry, CONFIG_FILE, LOG_FILE, MODEL_DIR, NetworkConfig, Objective,
+    Predictor, ReplayBuffer, Sample, SourceSelection, StepReport, TargetTransform, Training, TrainingConfig,
+    TrainingObserver, WEIGHTS_FILE, softplus, softplus_inverse,
+};
 pub use checkpoint::{AdditionCounts, CHECKPOINTS_DIR, latest_checkpoint};
 pub use cnn::{
-    CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnConfig, CnnModel, CnnObserver, CnnPredictor, CnnStepReport, CnnTraining,
-    cnn_rollouts,
+    CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnConfig, CnnModel, CnnObserver, CnnPredictor, CnnSizing, CnnStepReport,
+    CnnTraining,
 };
-pub use config::{DataConfig, LrSchedule, NetworkConfig, Objective, Profile, SourceSelection, TrainingConfig};
+pub use config::{DataConfig, LrSchedule, Profile};
 pub use error::{Result, TrainError};
-pub use inference::{
-    Evaluation, EvaluationSummary, MeshMetrics, Reference, Rollout, RolloutStep, StepStatus, StepSummary, rollouts,
+pub use method::{MethodConfig, TrainedModel};
+pub use rollout::{
+    Evaluation, EvaluationSummary, MeshMetrics, PredictedField, Reference, Rollout, RolloutStep, SizingModel,
+    StepStatus, StepSummary, rollouts,
 };
-pub use model::{AmberModel, Predictor, WEIGHTS_FILE};
-pub use target::{TargetTransform, softplus, softplus_inverse};
-pub use train::{Addition, CONFIG_FILE, LOG_FILE, MODEL_DIR, StepReport, Training, TrainingObserver};

@@ -8,8 +8,8 @@ use amber_fem::ExpertHeuristic;
 use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::{INITIAL_SIZE, LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, PoissonProblem};
 use amber_train::{
-    AmberModel, DataConfig, Evaluation, MODEL_DIR, NetworkConfig, Predictor, ReplayBuffer, StepReport, StepStatus,
-    Training, TrainingConfig, TrainingObserver, rollouts,
+    AmberModel, AmberSizing, DataConfig, Evaluation, MODEL_DIR, NetworkConfig, Predictor, ReplayBuffer, StepReport,
+    StepStatus, Training, TrainingConfig, TrainingObserver, rollouts,
 };
 
 /// Problems with small experts (8 refinement steps: a few hundred triangles).
@@ -176,8 +176,9 @@ fn rollouts_return_every_mesh_with_finite_metrics() {
     let model = AmberModel::load(&dir.path().join(MODEL_DIR)).unwrap();
     let evaluation = Evaluation::new(&train, training.limits()).unwrap();
     let steps = 3;
-    let out = rollouts(&model.network, &model.predictor, &train, &evaluation.references, steps).unwrap();
-    let (_, summary) = evaluation.run(training.network(), training.predictor(), steps).unwrap();
+    let out = rollouts(&model.sizing(), &train, &evaluation.references, steps).unwrap();
+    let live = AmberSizing { network: training.network(), predictor: training.predictor() };
+    let (_, summary) = evaluation.run(&live, steps).unwrap();
     assert_eq!(summary.steps.len(), steps);
     for rollout in &out {
         assert_eq!(rollout.steps.len(), steps);

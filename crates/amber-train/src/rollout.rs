@@ -1,21 +1,15 @@
-//! Inference (spec §6, reference notes §6.5): T generation steps from M⁰ (predict → clip at
-//! h_min → budget guard → generate → features), every intermediate mesh compared with the expert,
-//! normalised by the initial mesh M⁰ and the reconstruction M̂ (spec §7).
+//! Inference for both methods (spec §6, reference notes §6.5): T generation steps from M⁰
+//! (predict → clip at h_min → budget guard → generate), every intermediate mesh compared with
+//! the expert in the same parallel pass, normalised by the initial mesh M⁰ and the reconstruction
+//! M̂ (spec §7). A method plugs in through [`SizingModel`].
 
 use amber_mesh::Mesh;
 use amber_metrics::{compare_meshes, normalised_dcd};
-use amber_mpn::Mpn;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, in_problem};
-use amber_tasks::{MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step};
-
-use crate::Predictor;
-
-/// Predictions are made in batches of at most this many nodes (a rollout over many large
-/// problems would not fit one batch in memory).
-const PREDICTION_NODES: usize = 200_000;
+use crate::error::{Result, TrainError, in_problem};
+use amber_tasks::{MeshLimits, Problem, ProblemError, StepOutcome, generation_step};
 
 /// The per-problem constants of the normalised DCD: the reconstruction M̂ (the generator run
 /// with the expert's own sizing field, clipped at h_min) and the DCDs of M⁰ and M̂ to M*.
@@ -110,21 +104,43 @@ impl MeshMetrics {
     }
 }
 
-/// Rolls out `steps` generation steps on every problem in lockstep (one batched prediction per
-/// step, meshing in parallel). `references[i]` belongs to `problems[i]`.
-pub fn rollouts<const D: usize, P: Problem<D>>(
-    network: &Mpn,
-    predictor: &Predictor,
+/// A sizing field predicted for one generation step: the sizes of the elements of `mesh`, or of
+/// the current mesh's elements when `mesh` is `None`.
+pub struct PredictedField<const D: usize> {
+    /// The mesh the sizes live on when it is not the current mesh (the CNN's auxiliary mesh).
+    pub mesh: Option<Mesh<D>>,
+    pub sizes: Vec<f64>,
+}
+
+/// What a trained method contributes to a generation step: a sizing field for the current mesh
+/// of each problem, and the clip and budget the step meshes it under. Both methods implement
+/// it; [`rollouts`] is the one loop around it.
+pub trait SizingModel: Sync {
+    /// h_min and the element budget (from the training experts).
+    fn limits(&self) -> &MeshLimits;
+
+    /// The field of each `(problem, current mesh)` pair, in order.
+    fn predict<const D: usize, P: Problem<D>>(
+        &self,
+        problems: &[&P],
+        meshes: &[&Mesh<D>],
+    ) -> Result<Vec<PredictedField<D>>>;
+}
+
+/// Rolls out `steps` generation steps of `model` on every problem in lockstep (one prediction
+/// for all running problems per step, then meshing and metrics in one parallel pass).
+/// `references[i]` belongs to `problems[i]`. A step over the budget or failed keeps the previous
+/// mesh and stops that problem's rollout; later steps carry it forward as [`StepStatus::Stopped`].
+pub fn rollouts<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
+    model: &M,
     problems: &[P],
     references: &[Reference<D>],
     steps: usize,
 ) -> Result<Vec<Rollout<D>>> {
-    assert_eq!(problems.len(), references.len(), "one reference per problem");
-    let mut states: Vec<MeshState<D>> = problems
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| MeshState::new(p, &predictor.features, p.initial_mesh().clone()).map_err(in_problem(i)))
-        .collect::<Result<_>>()?;
+    if problems.len() != references.len() {
+        let message = format!("{} problems but {} references", problems.len(), references.len());
+        return Err(TrainError::InvalidConfig(message));
+    }
     let mut out: Vec<Rollout<D>> = problems
         .par_iter()
         .zip(references)
@@ -141,71 +157,47 @@ pub fn rollouts<const D: usize, P: Problem<D>>(
     let mut active = vec![true; problems.len()];
     for _ in 0..steps {
         let running: Vec<usize> = (0..problems.len()).filter(|&i| active[i]).collect();
-        let mut sizes = Vec::with_capacity(running.len());
-        for chunk in node_chunks(&running, |i| states[i].graph.num_nodes()) {
-            let batch: Vec<&MeshState<D>> = chunk.iter().map(|&i| &states[i]).collect();
-            sizes.extend(predictor.predict(network, &batch)?);
+        let current = |i: usize| out[i].steps.last().map_or(problems[i].initial_mesh(), |s| &s.mesh);
+        let fields = model.predict(
+            &running.iter().map(|&i| &problems[i]).collect::<Vec<_>>(),
+            &running.iter().map(|&i| current(i)).collect::<Vec<_>>(),
+        )?;
+        let mut fields: Vec<Option<PredictedField<D>>> = fields.into_iter().map(Some).collect();
+        let mut per_problem: Vec<Option<PredictedField<D>>> = (0..problems.len()).map(|_| None).collect();
+        for (&i, field) in running.iter().zip(&mut fields) {
+            per_problem[i] = field.take();
         }
-        let mut sizes: Vec<Option<Vec<f64>>> = sizes.into_iter().map(Some).collect();
-        let mut per_problem: Vec<Option<Vec<f64>>> = vec![None; problems.len()];
-        for (&i, s) in running.iter().zip(&mut sizes) {
-            per_problem[i] = s.take();
-        }
-        let advanced: Vec<(StepStatus, Option<MeshState<D>>)> = states
-            .par_iter()
-            .zip(per_problem)
+        let advanced: Vec<RolloutStep<D>> = per_problem
+            .into_par_iter()
             .enumerate()
-            .map(|(i, (state, sizes))| {
-                let Some(sizes) = sizes else { return Ok((StepStatus::Stopped, None)) };
-                Ok(match generation_step(&problems[i], &state.mesh, sizes, &predictor.limits) {
-                    StepOutcome::Meshed(mesh) => (
-                        StepStatus::Meshed,
-                        Some(MeshState::new(&problems[i], &predictor.features, mesh).map_err(in_problem(i))?),
-                    ),
-                    StepOutcome::OverBudget { estimated_elements } => {
-                        (StepStatus::OverBudget { estimated_elements }, None)
+            .map(|(i, field)| {
+                let (problem, previous) = (&problems[i], current(i));
+                let carried = |status| RolloutStep {
+                    status,
+                    mesh: previous.clone(),
+                    metrics: out[i].steps.last().map_or(out[i].initial, |s| s.metrics),
+                };
+                let Some(field) = field else { return Ok(carried(StepStatus::Stopped)) };
+                let on = field.mesh.as_ref().unwrap_or(previous);
+                Ok(match generation_step(problem, on, field.sizes, model.limits()) {
+                    StepOutcome::Meshed(mesh) => {
+                        let metrics =
+                            MeshMetrics::of(&mesh, problem.expert_mesh(), &references[i]).map_err(in_problem(i))?;
+                        RolloutStep { status: StepStatus::Meshed, mesh, metrics }
                     }
-                    StepOutcome::Failed { reason } => (StepStatus::Failed { reason }, None),
+                    StepOutcome::OverBudget { estimated_elements } => {
+                        carried(StepStatus::OverBudget { estimated_elements })
+                    }
+                    StepOutcome::Failed { reason } => carried(StepStatus::Failed { reason }),
                 })
             })
             .collect::<Result<_>>()?;
-        for (i, (status, next)) in advanced.into_iter().enumerate() {
-            match next {
-                Some(next) => states[i] = next,
-                None => active[i] = false,
-            }
-            let placeholder = out[i].initial;
-            out[i].steps.push(RolloutStep { status, mesh: states[i].mesh.clone(), metrics: placeholder });
+        for (i, step) in advanced.into_iter().enumerate() {
+            active[i] &= step.status == StepStatus::Meshed;
+            out[i].steps.push(step);
         }
-        out.par_iter_mut().zip(problems).zip(references).enumerate().try_for_each(|(i, ((rollout, p), r))| {
-            let previous = rollout.steps.iter().rev().nth(1).map_or(rollout.initial, |s| s.metrics);
-            let step = rollout.steps.last_mut().expect("pushed above");
-            step.metrics = match step.status {
-                StepStatus::Meshed => MeshMetrics::of(&step.mesh, p.expert_mesh(), r).map_err(in_problem(i))?,
-                // The mesh was carried forward, and so are its metrics.
-                _ => previous,
-            };
-            Ok::<_, crate::TrainError>(())
-        })?;
     }
     Ok(out)
-}
-
-/// Splits `items` into consecutive chunks of at most [`PREDICTION_NODES`] nodes (a larger single
-/// item forms a chunk alone).
-fn node_chunks(items: &[usize], nodes: impl Fn(usize) -> usize) -> Vec<Vec<usize>> {
-    let mut chunks: Vec<Vec<usize>> = Vec::new();
-    let mut total = 0;
-    for &i in items {
-        let n = nodes(i);
-        if chunks.is_empty() || total + n > PREDICTION_NODES {
-            chunks.push(Vec::new());
-            total = 0;
-        }
-        total += n;
-        chunks.last_mut().expect("pushed").push(i);
-    }
-    chunks
 }
 
 /// Means over problems at one generation step.
@@ -289,14 +281,9 @@ impl<'p, const D: usize, P: Problem<D>> Evaluation<'p, D, P> {
         Ok(Self { problems, references: Reference::for_problems(problems, limits)? })
     }
 
-    /// Rolls out `steps` steps on every problem and summarises.
-    pub fn run(
-        &self,
-        network: &Mpn,
-        predictor: &Predictor,
-        steps: usize,
-    ) -> Result<(Vec<Rollout<D>>, EvaluationSummary)> {
-        let rollouts = rollouts(network, predictor, self.problems, &self.references, steps)?;
+    /// Rolls out `steps` steps of `model` on every problem and summarises.
+    pub fn run(&self, model: &impl SizingModel, steps: usize) -> Result<(Vec<Rollout<D>>, EvaluationSummary)> {
+        let rollouts = rollouts(model, self.problems, &self.references, steps)?;
         let summary = EvaluationSummary::new(self.problems, &rollouts);
         Ok((rollouts, summary))
     }

@@ -1,5 +1,4 @@
-//! The U-Net CNN baseline (spec §8, reference notes §8), trained and evaluated on any
-//! [`Problem`]: an auxiliary uniform mesh of the problem's geometry with about two elements per
+//! Training the U-Net CNN baseline (spec §8, reference notes §8) on any [`Problem`]: an auxiliary uniform mesh of the problem's geometry with about two elements per
 //! pixel carries the task's input columns; they and a ±1 inside mask are rasterised onto an rᴰ
 //! grid over the geometry's bounding box; labels are the expert's projected sizing field (mean or
 //! max, spec §3) on the auxiliary mesh, copied to the pixels; the loss sees inside pixels only.
@@ -13,368 +12,18 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use amber_cnn::{CnnLoss, CnnTrainer, PixelGrid, Raster, TrainingImages, UNet, UNetConfig};
-use amber_graph::{Aggregation, GraphError, NodeFeature, RunningMoments, VARIANCE_EPSILON};
-use amber_mesh::Mesh;
-use amber_meshgen::SizingField;
+use amber_cnn::{CnnTrainer, TrainingImages, UNet};
+use amber_graph::RunningMoments;
 use amber_stdx::{read_json, write_json_atomic};
-use amber_tasks::{MeshLimits, Problem, StepOutcome, generation_step, labels};
+use amber_tasks::{MeshLimits, Problem, labels};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::model::{CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnModel, CnnPredictor, Rasterised, rasterise, transpose};
 use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, fingerprints, seeded_stream};
 use crate::error::{Result, TrainError, in_problem, io_error};
-use crate::{BufferEntry, DataConfig, MeshMetrics, Profile, Reference, Rollout, RolloutStep, StepStatus};
-
-/// File of the U-Net weights (and BatchNorm statistics) inside a CNN model directory.
-pub const CNN_WEIGHTS_FILE: &str = "cnn.safetensors";
-/// File of everything else of a CNN model ([`CnnPredictor`]).
-pub const CNN_PREDICTOR_FILE: &str = "cnn.json";
-
-/// Every knob of a CNN training run. Defaults are the `quick` profile.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct CnnConfig {
-    /// Seeds the network initialisation and the image subsets.
-    pub seed: u64,
-    /// Data the run reads.
-    pub data: DataConfig,
-    /// Pixels (voxels) per axis of the grid over the bounding box; a multiple of 16.
-    pub resolution: usize,
-    /// Channels of the U-Net's first level (the paper's runs 64, its text 32).
-    pub initial_channels: usize,
-    /// Output transform and loss.
-    pub loss: CnnLoss,
-    /// Mean or max projection of the expert onto the auxiliary mesh.
-    pub aggregation: Aggregation,
-    /// Gradient steps.
-    pub steps: u64,
-    /// Adam learning rate.
-    pub learning_rate: f64,
-    /// Global gradient-norm clip.
-    pub max_grad_norm: Option<f64>,
-    /// Training images per step, drawn without replacement; `None`: all (the paper).
-    pub images_per_step: Option<usize>,
-    /// Normalise the input channels by their moments over all training pixels.
-    pub normalise_inputs: bool,
-    /// Regress the targets standardised by their moments over the training pixels inside the
-    /// geometry (the later version's "Image (Var.)"); not with `softplus_mse`, whose targets are
-    /// sizes behind a non-linear output.
-    pub normalise_labels: bool,
-    /// Element budget = `budget_factor` × the largest training expert mesh.
-    pub budget_factor: f64,
-    /// Predictions are clipped below at this quantile of the training experts' element sizes.
-    pub min_size_quantile: f64,
-    /// Write a checkpoint every this many steps (and at the end).
-    pub checkpoint_interval: u64,
-}
-
-impl Default for CnnConfig {
-    fn default() -> Self {
-        Self::quick()
-    }
-}
-
-impl CnnConfig {
-    /// The paper's runs (spec §8, reference notes §8): resolution 256, 64 initial channels, MSE
-    /// on log sizes, mean labels, all 20 images in every one of 25,600 steps, Adam 3e-4, clip
-    /// 0.5. GPU scale.
-    pub fn paper() -> Self {
-        Self {
-            seed: 0,
-            data: DataConfig::default(),
-            resolution: 256,
-            initial_channels: 64,
-            loss: CnnLoss::LogMse,
-            aggregation: Aggregation::Mean,
-            steps: 25_600,
-            learning_rate: 3e-4,
-            max_grad_norm: Some(0.5),
-            images_per_step: None,
-            normalise_inputs: true,
-            normalise_labels: false,
-            budget_factor: 1.2,
-            min_size_quantile: 0.0,
-            checkpoint_interval: 1_000,
-        }
-    }
-
-    /// Two CPU cores: the paper's text width (32 channels), 2 random images per step,
-    /// standardised log-size targets and learning rate 1e-3,
-    /// which spare the hundreds of steps the output layer otherwise needs just to reach log sizes
-    /// around −5.
-    pub fn quick() -> Self {
-        Self {
-            initial_channels: 32,
-            steps: 400,
-            learning_rate: 1e-3,
-            images_per_step: Some(2),
-            normalise_labels: true,
-            checkpoint_interval: 100,
-            ..Self::paper()
-        }
-    }
-
-    /// For CI: two easy problems on a 32² grid, a narrow network, a few steps.
-    pub fn smoke() -> Self {
-        Self {
-            data: DataConfig { train_problems: 2, val_problems: 2 },
-            resolution: 32,
-            initial_channels: 8,
-            steps: 20,
-            images_per_step: None,
-            checkpoint_interval: 10,
-            ..Self::quick()
-        }
-    }
-
-    /// The config of a named profile.
-    pub fn profile(profile: Profile) -> Self {
-        match profile {
-            Profile::Smoke => Self::smoke(),
-            Profile::Quick => Self::quick(),
-            Profile::Paper => Self::paper(),
-        }
-    }
-
-    /// The U-Net of this run for inputs with `in_channels` channels in `D` dimensions.
-    pub fn network<const D: usize>(&self, in_channels: usize) -> UNetConfig {
-        UNetConfig { spatial_axes: D, in_channels, initial_channels: self.initial_channels, depth: 4 }
-    }
-
-    /// Checks ranges; the message names the field.
-    pub fn validate(&self) -> Result<()> {
-        let bad = |m: &str| Err(TrainError::InvalidConfig(m.to_owned()));
-        let multiple = UNetConfig { spatial_axes: 2, in_channels: 1, initial_channels: 1, depth: 4 }.size_multiple();
-        if self.resolution == 0 || !self.resolution.is_multiple_of(multiple) {
-            return bad("resolution must be a positive multiple of 16 (four poolings by 2)");
-        }
-        if self.initial_channels == 0 || self.steps == 0 || self.checkpoint_interval == 0 {
-            return bad("initial_channels, steps and checkpoint_interval must be positive");
-        }
-        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
-            return bad("learning_rate must be positive");
-        }
-        if self.max_grad_norm.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
-            return bad("max_grad_norm must be positive");
-        }
-        if self.images_per_step == Some(0) {
-            return bad("images_per_step must be positive (or absent: all)");
-        }
-        if !(self.budget_factor.is_finite() && self.budget_factor > 0.0) {
-            return bad("budget_factor must be positive");
-        }
-        if !(0.0..=1.0).contains(&self.min_size_quantile) {
-            return bad("min_size_quantile must be in [0, 1]");
-        }
-        if self.normalise_labels && self.loss == CnnLoss::SoftplusMse {
-            return bad("normalise_labels needs loss log_mse or mse");
-        }
-        // Upper bounds that a machine can hold, so that a typo is an error, not an abort.
-        if self.resolution > 2_048 || self.initial_channels > 1_024 || self.data.train_problems > 1_000_000 {
-            return bad("resolution at most 2048, initial_channels at most 1024, data.train_problems at most 1000000");
-        }
-        Ok(())
-    }
-}
-
-/// Everything of a trained CNN except its weights.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CnnPredictor {
-    pub network: UNetConfig,
-    /// Pixels per axis.
-    pub resolution: usize,
-    pub loss: CnnLoss,
-    /// Moments of the input channels over the training pixels; `None`: inputs are fed raw.
-    pub normaliser: Option<RunningMoments>,
-    /// Moments of the targets over the inside training pixels; `None`: the network regresses
-    /// the raw targets.
-    pub label_moments: Option<RunningMoments>,
-    /// h_min and the element budget (from the training experts).
-    pub limits: MeshLimits,
-}
-
-/// One problem's auxiliary mesh, rasterised, with the network input of its pixels.
-struct Rasterised<const D: usize> {
-    auxiliary: Mesh<D>,
-    raster: Raster<D>,
-    /// Channel-major `(columns + mask) × pixels`, not normalised.
-    channels: Vec<f32>,
-}
-
-/// Target size of the auxiliary mesh's elements: the reference's element volume
-/// vol(bounding box)/(2·rᴰ), about two elements per pixel.
-fn auxiliary_size<const D: usize>(grid: &PixelGrid<D>) -> f64 {
-    amber_mesh::size_from_volume::<D>(grid.cell_volume() / 2.0)
-}
-
-/// Meshes the auxiliary mesh of `problem` for a grid of `resolution` pixels per axis over its
-/// geometry's bounding box, computes its columns and rasterises them.
-fn rasterise<const D: usize, P: Problem<D> + ?Sized>(
-    problem: &P,
-    index: usize,
-    resolution: usize,
-) -> Result<Rasterised<D>> {
-    let initial = problem.initial_mesh();
-    let grid = PixelGrid::over_mesh(initial, resolution)?;
-    let size = auxiliary_size(&grid);
-    let expected = initial.total_volume() / amber_mesh::volume_from_size::<D>(size);
-    let cap = (4.0 * expected) as usize + 1_000;
-    let auxiliary = problem.remesh(initial, vec![size; initial.num_elements()], cap).map_err(in_problem(index))?;
-    let raster = Raster::new(grid, &auxiliary)?;
-    // The task's own input columns, in its feature set's order: a problem may compute more
-    // (optional AMBER inputs) than the baseline reads.
-    let columns = problem.columns(&auxiliary).map_err(in_problem(index))?;
-    let values: Vec<&[f64]> = problem
-        .feature_set()
-        .node
-        .iter()
-        .filter_map(|feature| match feature {
-            NodeFeature::Column(name) => Some(name),
-            _ => None,
-        })
-        .map(|name| {
-            let column = columns.iter().find(|c| &c.name == name);
-            column
-                .map(|c| c.values.as_slice())
-                .ok_or_else(|| in_problem(index)(GraphError::MissingColumn { name: name.clone() }))
-        })
-        .collect::<Result<_>>()?;
-    let channels = raster.channels(&values)?;
-    Ok(Rasterised { auxiliary, raster, channels })
-}
-
-/// Channel-major `channels × pixels` ↔ pixel-major rows (the normaliser's layout).
-fn transpose(data: &[f32], rows: usize, cols: usize) -> Vec<f32> {
-    let mut out = vec![0.0; data.len()];
-    for r in 0..rows {
-        for c in 0..cols {
-            out[c * rows + r] = data[r * cols + c];
-        }
-    }
-    out
-}
-
-impl CnnPredictor {
-    /// The normalised network input of one rasterised problem, channel-major `C × pixels`.
-    fn input<const D: usize>(&self, sample: &Rasterised<D>) -> Result<Vec<f32>> {
-        let (channels, pixels) = (self.network.in_channels, sample.raster.grid.len());
-        if sample.channels.len() != channels * pixels {
-            return Err(TrainError::InvalidConfig(format!(
-                "the problem gives {} input channels, the network takes {channels}",
-                sample.channels.len() / pixels
-            )));
-        }
-        Ok(match &self.normaliser {
-            Some(moments) => {
-                let mut rows = transpose(&sample.channels, channels, pixels);
-                moments.normalise(&mut rows)?;
-                transpose(&rows, pixels, channels)
-            }
-            None => sample.channels.clone(),
-        })
-    }
-
-    /// The predicted size of every auxiliary element: the network's pixel field, outside pixels
-    /// filled from inside ones, read at the element midpoints.
-    fn predict<const D: usize>(&self, network: &UNet, sample: &Rasterised<D>) -> Result<Vec<f64>> {
-        let shape: Vec<usize> = [1, self.network.in_channels].into_iter().chain(sample.raster.grid.shape).collect();
-        let z = network.predict(&self.input(sample)?, &shape)?;
-        let (scale, shift) = match &self.label_moments {
-            Some(m) => ((m.variance()[0] + VARIANCE_EPSILON).sqrt(), m.mean()[0]),
-            None => (1.0, 0.0),
-        };
-        let mut sizes: Vec<f64> = z.into_iter().map(|z| self.loss.size(f64::from(z) * scale + shift)).collect();
-        sample.raster.fill_outside(&mut sizes)?;
-        let field = sample.raster.grid.sizing(sizes);
-        Ok(sample.auxiliary.midpoints().into_iter().map(|x| field.size_at(x)).collect())
-    }
-}
-
-/// A trained CNN ready for inference.
-pub struct CnnModel {
-    pub network: UNet,
-    pub predictor: CnnPredictor,
-}
-
-impl CnnModel {
-    /// Writes `cnn.safetensors` and `cnn.json` into `dir` (created if missing).
-    pub fn save(network: &UNet, predictor: &CnnPredictor, dir: &Path) -> Result<()> {
-        std::fs::create_dir_all(dir).map_err(io_error(dir))?;
-        network.save(&dir.join(CNN_WEIGHTS_FILE))?;
-        Ok(write_json_atomic(&dir.join(CNN_PREDICTOR_FILE), predictor)?)
-    }
-
-    /// Loads a model directory written by [`Self::save`] (a checkpoint directory is one too).
-    pub fn load(dir: &Path) -> Result<Self> {
-        let predictor: CnnPredictor = read_json(&dir.join(CNN_PREDICTOR_FILE))?;
-        let network = UNet::load(predictor.network.clone(), &dir.join(CNN_WEIGHTS_FILE))?;
-        Ok(Self { network, predictor })
-    }
-
-    /// One generation step from M⁰ for every problem (see [`cnn_rollouts`]).
-    pub fn rollouts<const D: usize, P: Problem<D>>(
-        &self,
-        problems: &[P],
-        references: &[Reference<D>],
-    ) -> Result<Vec<Rollout<D>>> {
-        cnn_rollouts(&self.network, &self.predictor, problems, references)
-    }
-}
-
-/// One generation step from M⁰ for every problem (the CNN predicts once), as rollouts with the
-/// same metrics as AMBER's; `references[i]` belongs to `problems[i]`. A step over the budget or
-/// failed keeps M⁰ and its metrics.
-pub fn cnn_rollouts<const D: usize, P: Problem<D>>(
-    network: &UNet,
-    predictor: &CnnPredictor,
-    problems: &[P],
-    references: &[Reference<D>],
-) -> Result<Vec<Rollout<D>>> {
-    if problems.len() != references.len() {
-        return Err(TrainError::InvalidConfig(format!(
-            "{} problems but {} references",
-            problems.len(),
-            references.len()
-        )));
-    }
-    problems.par_iter().zip(references).enumerate().map(|(i, (p, r))| rollout(network, predictor, p, r, i)).collect()
-}
-
-fn rollout<const D: usize, P: Problem<D>>(
-    network: &UNet,
-    predictor: &CnnPredictor,
-    problem: &P,
-    reference: &Reference<D>,
-    i: usize,
-) -> Result<Rollout<D>> {
-    let sample = rasterise(problem, i, predictor.resolution)?;
-    let sizes = predictor.predict(network, &sample)?;
-    let initial = MeshMetrics::of(problem.initial_mesh(), problem.expert_mesh(), reference).map_err(in_problem(i))?;
-    let step = match generation_step(problem, &sample.auxiliary, sizes, &predictor.limits) {
-        StepOutcome::Meshed(mesh) => {
-            let metrics = MeshMetrics::of(&mesh, problem.expert_mesh(), reference).map_err(in_problem(i))?;
-            RolloutStep { status: StepStatus::Meshed, mesh, metrics }
-        }
-        StepOutcome::OverBudget { estimated_elements } => RolloutStep {
-            status: StepStatus::OverBudget { estimated_elements },
-            mesh: problem.initial_mesh().clone(),
-            metrics: initial,
-        },
-        StepOutcome::Failed { reason } => RolloutStep {
-            status: StepStatus::Failed { reason },
-            mesh: problem.initial_mesh().clone(),
-            metrics: initial,
-        },
-    };
-    Ok(Rollout {
-        initial,
-        steps: vec![step],
-        initial_dcd: reference.initial_dcd,
-        reconstruction_dcd: reference.reconstruction_dcd,
-    })
-}
+use crate::{BufferEntry, CnnConfig};
 
 /// One gradient step of a CNN run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -637,6 +286,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{CnnSizing, Reference, rollouts};
     use amber_fem::ExpertHeuristic;
     use amber_graph::FeatureSet;
     use amber_mesh::Mesh3;
@@ -665,23 +315,6 @@ mod tests {
 
     fn single_thread<T: Send>(f: impl FnOnce() -> T + Send) -> T {
         rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(f)
-    }
-
-    #[test]
-    fn profiles_are_valid_and_round_trip_through_json() {
-        for profile in Profile::ALL {
-            let config = CnnConfig::profile(profile);
-            config.validate().unwrap();
-            let json = serde_json::to_string(&config).unwrap();
-            assert_eq!(serde_json::from_str::<CnnConfig>(&json).unwrap(), config);
-        }
-        let partial: CnnConfig = serde_json::from_str(r#"{"resolution": 64, "loss": "softplus_mse"}"#).unwrap();
-        assert_eq!(partial, CnnConfig { resolution: 64, loss: CnnLoss::SoftplusMse, ..CnnConfig::quick() });
-        assert!(CnnConfig { resolution: 40, ..CnnConfig::quick() }.validate().is_err());
-        assert!(CnnConfig { images_per_step: Some(0), ..CnnConfig::quick() }.validate().is_err());
-        assert!(
-            CnnConfig { loss: CnnLoss::SoftplusMse, normalise_labels: true, ..CnnConfig::quick() }.validate().is_err()
-        );
     }
 
     #[test]
@@ -718,8 +351,9 @@ mod tests {
             let model = CnnModel::load(&model_dir).unwrap();
             let tests = poisson(&[21]);
             let references = Reference::for_problems(&tests, &model.predictor.limits).unwrap();
-            let live = cnn_rollouts(again.network(), again.predictor(), &tests, &references).unwrap();
-            let loaded = model.rollouts(&tests, &references).unwrap();
+            let live_model = CnnSizing { network: again.network(), predictor: again.predictor() };
+            let live = rollouts(&live_model, &tests, &references, 1).unwrap();
+            let loaded = rollouts(&model.sizing(), &tests, &references, 1).unwrap();
             assert_eq!(loaded.len(), 1);
             assert_eq!(loaded[0].steps.len(), 1);
             assert_eq!(live[0].steps[0].metrics, loaded[0].steps[0].metrics);
@@ -800,7 +434,8 @@ mod tests {
         }
         let tests = [CubeProblem { initial: cube(1), expert: cube(3) }];
         let references = Reference::for_problems(&tests, &training.predictor().limits).unwrap();
-        let rollouts = cnn_rollouts(training.network(), training.predictor(), &tests, &references).unwrap();
+        let sizing = CnnSizing { network: training.network(), predictor: training.predictor() };
+        let rollouts = rollouts(&sizing, &tests, &references, 1).unwrap();
         assert_eq!(rollouts[0].steps.len(), 1);
     }
 }

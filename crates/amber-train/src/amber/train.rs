@@ -17,13 +17,14 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::model::WEIGHTS_FILE;
 use crate::checkpoint::{
     self, AdditionCounts, EntryRecord, OPTIMISER_FILE, RngState, STATE_FILE, TrainingState, fingerprints, seeded_stream,
 };
 use crate::error::{Result, TrainError, in_problem, io_error};
-use crate::model::WEIGHTS_FILE;
 use crate::{
-    AmberModel, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, TargetTransform, TrainingConfig,
+    AmberModel, AmberSizing, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, TargetTransform,
+    TrainingConfig,
 };
 
 /// The final model's sub-directory of the output directory.
@@ -174,7 +175,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             return Err(fail("the training problems differ from the checkpointed run's".into()));
         }
         state.check(problems.len()).map_err(fail)?;
-        let predictor: Predictor = read_json(&dir.join(crate::model::PREDICTOR_FILE))?;
+        let predictor: Predictor = read_json(&dir.join(super::model::PREDICTOR_FILE))?;
         let mut trainer = MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.max_grad_norm)?;
         trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
@@ -361,7 +362,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
 
     /// Rolls out the current model on `validation` (evaluation mode) and summarises.
     pub fn validate(&self, validation: &Evaluation<'_, D, P>) -> Result<EvaluationSummary> {
-        Ok(validation.run(self.trainer.network(), &self.predictor, self.config.inference_steps)?.1)
+        let sizing = AmberSizing { network: self.trainer.network(), predictor: &self.predictor };
+        Ok(validation.run(&sizing, self.config.inference_steps)?.1)
     }
 
     /// Writes the current model (network, normalisers, target transform, limits) to `dir`.

@@ -8,10 +8,12 @@ use amber_mpn::{Mpn, MpnTrainer};
 use amber_stdx::{read_json, write_json_atomic};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, io_error};
-use amber_tasks::{MeshLimits, MeshState};
+use amber_mesh::Mesh;
+use amber_tasks::{MeshLimits, MeshState, Problem};
+use rayon::prelude::*;
 
-use crate::TargetTransform;
+use crate::error::{Result, in_problem, io_error};
+use crate::{PredictedField, SizingModel, TargetTransform};
 
 /// File of the network weights inside a model directory (its config is `model.json`).
 pub const WEIGHTS_FILE: &str = "model.safetensors";
@@ -49,6 +51,61 @@ impl Predictor {
     }
 }
 
+/// Predictions are made in batches of at most this many nodes (a rollout over many large
+/// problems would not fit one batch in memory).
+const PREDICTION_NODES: usize = 200_000;
+
+/// A network with its predictor, as a [`SizingModel`]: the field of a mesh is the prediction on
+/// its graph (columns from the problem), in batches of at most [`PREDICTION_NODES`] nodes.
+pub struct AmberSizing<'m> {
+    pub network: &'m Mpn,
+    pub predictor: &'m Predictor,
+}
+
+impl SizingModel for AmberSizing<'_> {
+    fn limits(&self) -> &MeshLimits {
+        &self.predictor.limits
+    }
+
+    fn predict<const D: usize, P: Problem<D>>(
+        &self,
+        problems: &[&P],
+        meshes: &[&Mesh<D>],
+    ) -> Result<Vec<PredictedField<D>>> {
+        let states: Vec<MeshState<D>> = problems
+            .par_iter()
+            .zip(meshes)
+            .enumerate()
+            .map(|(i, (p, m))| MeshState::new(*p, &self.predictor.features, (*m).clone()).map_err(in_problem(i)))
+            .collect::<Result<_>>()?;
+        let all: Vec<usize> = (0..states.len()).collect();
+        let mut fields = Vec::with_capacity(states.len());
+        for chunk in node_chunks(&all, |i| states[i].graph.num_nodes()) {
+            let batch: Vec<&MeshState<D>> = chunk.iter().map(|&i| &states[i]).collect();
+            let sizes = self.predictor.predict(self.network, &batch)?;
+            fields.extend(sizes.into_iter().map(|sizes| PredictedField { mesh: None, sizes }));
+        }
+        Ok(fields)
+    }
+}
+
+/// Splits `items` into consecutive chunks of at most [`PREDICTION_NODES`] nodes (a larger single
+/// item forms a chunk alone).
+fn node_chunks(items: &[usize], nodes: impl Fn(usize) -> usize) -> Vec<Vec<usize>> {
+    let mut chunks: Vec<Vec<usize>> = Vec::new();
+    let mut total = 0;
+    for &i in items {
+        let n = nodes(i);
+        if chunks.is_empty() || total + n > PREDICTION_NODES {
+            chunks.push(Vec::new());
+            total = 0;
+        }
+        total += n;
+        chunks.last_mut().expect("pushed").push(i);
+    }
+    chunks
+}
+
 /// A trained model ready for inference.
 pub struct AmberModel {
     pub network: Mpn,
@@ -75,5 +132,10 @@ impl AmberModel {
     /// Predicted element sizes for each state.
     pub fn predict<const D: usize>(&self, states: &[&MeshState<D>]) -> Result<Vec<Vec<f64>>> {
         self.predictor.predict(&self.network, states)
+    }
+
+    /// The model as a [`SizingModel`] for rollouts.
+    pub fn sizing(&self) -> AmberSizing<'_> {
+        AmberSizing { network: &self.network, predictor: &self.predictor }
     }
 }

@@ -1,0 +1,157 @@
+//! A method as one value: the configuration of a run of either method ([`MethodConfig`]) and a
+//! trained model of either method ([`TrainedModel`]), so that callers train, load and roll out
+//! without knowing which one they hold.
+
+use std::path::Path;
+
+use amber_tasks::{MeshLimits, Problem};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, TrainError};
+use crate::{
+    AmberModel, CNN_PREDICTOR_FILE, CnnConfig, CnnModel, CnnObserver, CnnTraining, DataConfig, Evaluation, MODEL_DIR,
+    Rollout, Training, TrainingConfig, TrainingObserver,
+};
+
+/// The configuration of one run of either method.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MethodConfig {
+    Amber(TrainingConfig),
+    Cnn(CnnConfig),
+}
+
+impl MethodConfig {
+    /// Generation steps of the method's rollouts (the CNN predicts once).
+    pub fn inference_steps(&self) -> usize {
+        match self {
+            MethodConfig::Amber(c) => c.inference_steps,
+            MethodConfig::Cnn(_) => 1,
+        }
+    }
+
+    pub fn seed(&self) -> u64 {
+        match self {
+            MethodConfig::Amber(c) => c.seed,
+            MethodConfig::Cnn(c) => c.seed,
+        }
+    }
+
+    /// Gradient steps of the run.
+    pub fn steps(&self) -> u64 {
+        match self {
+            MethodConfig::Amber(c) => c.steps,
+            MethodConfig::Cnn(c) => c.steps,
+        }
+    }
+
+    /// How many training and validation problems the run reads.
+    pub fn data(&self) -> &DataConfig {
+        match self {
+            MethodConfig::Amber(c) => &c.data,
+            MethodConfig::Cnn(c) => &c.data,
+        }
+    }
+
+    /// Whether the run validates during training (the CNN does not).
+    pub fn validates(&self) -> bool {
+        matches!(self, MethodConfig::Amber(c) if c.validation_interval > 0)
+    }
+
+    /// Checks ranges and combinations; the message names the field.
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            MethodConfig::Amber(c) => c.validate(),
+            MethodConfig::Cnn(c) => c.validate(),
+        }
+    }
+
+    /// The config alone, untagged, as its run directory's `config.json` holds it.
+    pub fn to_json(&self) -> serde_json::Value {
+        let value = match self {
+            MethodConfig::Amber(c) => serde_json::to_value(c),
+            MethodConfig::Cnn(c) => serde_json::to_value(c),
+        };
+        value.expect("configs serialise")
+    }
+
+    /// Trains into `out_dir` until the config's last step, resuming its newest checkpoint (the
+    /// configuration and problems must be those of the checkpointed run); AMBER validates on
+    /// `val` as configured. Writes the final model to `out_dir/model`. `ready` is told the
+    /// training's step and limits once it stands, before the first step.
+    pub fn train<const D: usize, P: Problem<D>, O: TrainingObserver + CnnObserver>(
+        &self,
+        train: Vec<P>,
+        val: &[P],
+        out_dir: &Path,
+        observer: &mut O,
+        ready: impl FnOnce(u64, &MeshLimits, &mut O),
+    ) -> Result<()> {
+        match self {
+            MethodConfig::Amber(config) => {
+                let mut training = Training::open(config.clone(), train, out_dir)?;
+                let validation = Evaluation::new(val, training.limits())?;
+                ready(training.step(), training.limits(), observer);
+                training.run(out_dir, Some(&validation), observer)
+            }
+            MethodConfig::Cnn(config) => {
+                let mut training = CnnTraining::open(config.clone(), train, out_dir)?;
+                ready(training.step(), &training.predictor().limits, observer);
+                training.run(out_dir, observer).map(|_| ())
+            }
+        }
+    }
+}
+
+/// A trained model of either method, as a directory holds it.
+pub enum TrainedModel {
+    Amber(AmberModel),
+    Cnn(CnnModel),
+}
+
+impl TrainedModel {
+    /// Loads the model in `dir` (a run's `model/` or a checkpoint directory), of whichever method
+    /// wrote it; a run directory is accepted for its `model/`.
+    pub fn load(dir: &Path) -> Result<Self> {
+        let dir = if dir.join(MODEL_DIR).is_dir() { dir.join(MODEL_DIR) } else { dir.to_owned() };
+        if dir.join(CNN_PREDICTOR_FILE).exists() {
+            Ok(TrainedModel::Cnn(CnnModel::load(&dir)?))
+        } else if dir.join(crate::amber::PREDICTOR_FILE).exists() {
+            Ok(TrainedModel::Amber(AmberModel::load(&dir)?))
+        } else {
+            Err(TrainError::InvalidConfig(format!(
+                "{}: not a model directory (no {} or {CNN_PREDICTOR_FILE})",
+                dir.display(),
+                crate::amber::PREDICTOR_FILE
+            )))
+        }
+    }
+
+    /// h_min and the element budget, to read or to change (e.g. to scale fields to the budget).
+    pub fn limits_mut(&mut self) -> &mut MeshLimits {
+        match self {
+            TrainedModel::Amber(m) => &mut m.predictor.limits,
+            TrainedModel::Cnn(m) => &mut m.predictor.limits,
+        }
+    }
+
+    /// Rolls the model out for `steps` generation steps on every problem of `evaluation`.
+    pub fn rollouts<const D: usize, P: Problem<D>>(
+        &self,
+        evaluation: &Evaluation<'_, D, P>,
+        steps: usize,
+    ) -> Result<Vec<Rollout<D>>> {
+        match self {
+            TrainedModel::Amber(m) => Ok(evaluation.run(&m.sizing(), steps)?.0),
+            TrainedModel::Cnn(m) => Ok(evaluation.run(&m.sizing(), steps)?.0),
+        }
+    }
+
+    /// h_min and the element budget.
+    pub fn limits(&self) -> &MeshLimits {
+        match self {
+            TrainedModel::Amber(m) => &m.predictor.limits,
+            TrainedModel::Cnn(m) => &m.predictor.limits,
+        }
+    }
+}
