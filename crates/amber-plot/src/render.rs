@@ -7,6 +7,7 @@
 //! (painter's algorithm on the front-facing boundary triangles) and their edges are found in a
 //! buffer of which triangle each pixel shows, so hidden edges never show through.
 
+use nalgebra::Vector3;
 use std::path::Path;
 
 use amber_mesh::{FacetAdjacency, Mesh2, Mesh3, MeshError, signed_volume};
@@ -163,36 +164,32 @@ pub fn render_surface_png(
 /// to front, with their tetrahedra's values and their shading factors in (0, 1].
 fn visible_surface(mesh: &Mesh3, values: &[f64], view: View) -> Result<(Mesh2, Vec<f64>, Vec<f64>), MeshError> {
     let (az, el) = (view.azimuth_deg.to_radians(), view.elevation_deg.to_radians());
-    let eye = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
-    let right = [-az.sin(), az.cos(), 0.0];
-    let up = cross(eye, right);
-    let light = normalised([
-        eye[0] + 0.4 * up[0] + 0.3 * right[0],
-        eye[1] + 0.4 * up[1] + 0.3 * right[1],
-        eye[2] + 0.4 * up[2] + 0.3 * right[2],
-    ]);
+    let eye = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+    let right = Vector3::new(-az.sin(), az.cos(), 0.0);
+    let up = eye.cross(&right);
+    let light = normalised(eye + 0.4 * up + 0.3 * right);
     let adjacency = FacetAdjacency::new(mesh)?;
-    let vertices = mesh.vertices();
+    let vertices: Vec<Vector3<f64>> = mesh.vertices().iter().map(|&p| Vector3::from(p)).collect();
     let mut faces: Vec<(f64, [u32; 3], f64, f64)> = Vec::new();
     for (element, local) in adjacency.boundary_facets() {
         let cell = mesh.element(element);
         let mut tri: Vec<u32> = (0..4).filter(|&k| k != local).map(|k| cell[k]).collect();
         let [a, b, c] = [0, 1, 2].map(|k| vertices[tri[k] as usize]);
-        let mut normal = cross(sub(b, a), sub(c, a));
-        if dot(normal, sub(vertices[cell[local] as usize], a)) > 0.0 {
-            normal = normal.map(|x| -x);
+        let mut normal = (b - a).cross(&(c - a));
+        if normal.dot(&(vertices[cell[local] as usize] - a)) > 0.0 {
+            normal = -normal;
             tri.swap(1, 2);
         }
         let normal = normalised(normal);
-        if dot(normal, eye) <= 0.0 {
+        if normal.dot(&eye) <= 0.0 {
             continue;
         }
-        let depth = dot([(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0], eye);
-        let shade = 0.35 + 0.65 * dot(normal, light).max(0.0);
+        let depth = ((a + b + c) / 3.0).dot(&eye);
+        let shade = 0.35 + 0.65 * normal.dot(&light).max(0.0);
         faces.push((depth, [tri[0], tri[1], tri[2]], values[element], shade));
     }
     faces.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let points: Vec<[f64; 2]> = vertices.iter().map(|&p| [dot(p, right), dot(p, up)]).collect();
+    let points: Vec<[f64; 2]> = vertices.iter().map(|p| [p.dot(&right), p.dot(&up)]).collect();
     let extent = points.iter().fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs())).max(f64::MIN_POSITIVE);
     // Triangles seen edge-on have no area to draw (and are no valid 2D elements).
     faces.retain(|(_, t, _, _)| signed_volume::<2>(&points, t) > 1e-12 * extent * extent);
@@ -201,21 +198,9 @@ fn visible_surface(mesh: &Mesh3, values: &[f64], view: View) -> Result<(Mesh2, V
     Ok((projected, faces.iter().map(|f| f.2).collect(), faces.iter().map(|f| f.3).collect()))
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn normalised(a: [f64; 3]) -> [f64; 3] {
-    let n = dot(a, a).sqrt().max(f64::MIN_POSITIVE);
-    a.map(|x| x / n)
+/// `a` scaled to unit length (a zero vector stays zero).
+fn normalised(a: Vector3<f64>) -> Vector3<f64> {
+    a / a.norm().max(f64::MIN_POSITIVE)
 }
 
 /// Maps values to [0, 1] along the colour bar.
