@@ -53,9 +53,9 @@ impl MethodConfig {
         }
     }
 
-    /// Whether the run validates during training (the CNN does not).
+    /// Whether the run reads validation problems (AMBER does, the CNN does not validate).
     pub fn validates(&self) -> bool {
-        matches!(self, MethodConfig::Amber(c) if c.validation_interval > 0)
+        matches!(self, MethodConfig::Amber(_))
     }
 
     /// Checks ranges and combinations; the message names the field.
