@@ -7,6 +7,11 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+/// The paper's optimiser for both methods (spec §5, §8): Adam at this learning rate...
+pub const PAPER_LEARNING_RATE: f64 = 3e-4;
+/// ... with the gradients' global norm clipped to this.
+pub const PAPER_MAX_GRAD_NORM: f64 = 0.5;
+
 /// Learning-rate schedule over the whole run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]

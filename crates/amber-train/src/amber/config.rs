@@ -3,6 +3,7 @@
 use amber_graph::Aggregation;
 use serde::{Deserialize, Serialize};
 
+use crate::config::{PAPER_LEARNING_RATE, PAPER_MAX_GRAD_NORM};
 use crate::error::{Result, TrainError};
 use crate::{DataConfig, LrSchedule, Profile};
 
@@ -137,9 +138,9 @@ impl TrainingConfig {
             inputs: Vec::new(),
             network: NetworkConfig::default(),
             steps: 128_000,
-            learning_rate: 3e-4,
+            learning_rate: PAPER_LEARNING_RATE,
             lr_schedule: LrSchedule::Constant,
-            max_grad_norm: Some(0.5),
+            max_grad_norm: Some(PAPER_MAX_GRAD_NORM),
             batch_nodes: 400_000,
             buffer_capacity: 1_000,
             add_interval: 8,

@@ -4,6 +4,7 @@ use amber_cnn::{CnnLoss, UNetConfig};
 use amber_graph::Aggregation;
 use serde::{Deserialize, Serialize};
 
+use crate::config::{PAPER_LEARNING_RATE, PAPER_MAX_GRAD_NORM};
 use crate::error::{Result, TrainError};
 use crate::{DataConfig, Profile};
 
@@ -64,8 +65,8 @@ impl CnnConfig {
             loss: CnnLoss::LogMse,
             aggregation: Aggregation::Mean,
             steps: 25_600,
-            learning_rate: 3e-4,
-            max_grad_norm: Some(0.5),
+            learning_rate: PAPER_LEARNING_RATE,
+            max_grad_norm: Some(PAPER_MAX_GRAD_NORM),
             images_per_step: None,
             normalise_inputs: true,
             normalise_labels: false,
