@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
-use crate::profiles::{Task, amber_config, cnn_config};
+use crate::profiles::{Overrides, Task, run_config};
 use crate::results::ExperimentResults;
 use crate::run::{GALLERY_PROBLEMS, Run, evaluation_name, train_run};
 
@@ -73,27 +73,10 @@ impl ConsoleExperiment {
         }
     }
 
-    /// The configuration of one run: the Console task's profile (see [`amber_config`]), with the
-    /// method's labels, the overrides and the seed.
+    /// The configuration of one run (see [`run_config`]).
     pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<MethodConfig> {
-        Ok(match spec.method {
-            Method::AmberMean | Method::AmberMax => {
-                let mut config = amber_config(Task::Console, self.profile);
-                config.aggregation = spec.method.aggregation();
-                config.seed = seed as u64;
-                let config = spec.patched(&config, &self.overrides)?;
-                config.validate()?;
-                MethodConfig::Amber(config)
-            }
-            Method::Cnn { resolution } => {
-                let mut config = cnn_config(Task::Console, self.profile, resolution);
-                config.aggregation = spec.method.aggregation();
-                config.seed = seed as u64;
-                let config = spec.patched(&config, &self.cnn_overrides)?;
-                config.validate()?;
-                MethodConfig::Cnn(config)
-            }
-        })
+        let overrides = Overrides { amber: &self.overrides, cnn: &self.cnn_overrides };
+        run_config(Task::Console, self.profile, spec, seed, overrides)
     }
 
     /// Runs the experiment and writes its outputs under `out`.

@@ -16,7 +16,7 @@ use serde::Serialize;
 
 use crate::method::{Method, MethodSpec, Variant};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
-use crate::profiles::{Task, amber_config, cnn_config};
+use crate::profiles::{Overrides, Task, amber_config, run_config};
 use crate::progress::item_bar;
 use crate::report::merge_json;
 use crate::results::ExperimentResults;
@@ -153,27 +153,10 @@ impl PoissonExperiment {
         experiment
     }
 
-    /// The configuration of one run: the profile's, with the method's labels, the variant's and
-    /// the user's overrides (AMBER runs: `overrides`, CNN runs: `cnn_overrides`) and the seed.
+    /// The configuration of one run (see [`run_config`]).
     pub fn run_config(&self, spec: &MethodSpec, seed: usize) -> anyhow::Result<MethodConfig> {
-        Ok(match spec.method {
-            Method::AmberMean | Method::AmberMax => {
-                let mut config = amber_config(Task::Poisson, self.profile);
-                config.aggregation = spec.method.aggregation();
-                config.seed = seed as u64;
-                let config = spec.patched(&config, &self.overrides)?;
-                config.validate()?;
-                MethodConfig::Amber(config)
-            }
-            Method::Cnn { resolution } => {
-                let mut config = cnn_config(Task::Poisson, self.profile, resolution);
-                config.aggregation = spec.method.aggregation();
-                config.seed = seed as u64;
-                let config = spec.patched(&config, &self.cnn_overrides)?;
-                config.validate()?;
-                MethodConfig::Cnn(config)
-            }
-        })
+        let overrides = Overrides { amber: &self.overrides, cnn: &self.cnn_overrides };
+        run_config(Task::Poisson, self.profile, spec, seed, overrides)
     }
 
     /// Runs the experiment and writes its outputs under `out`.

@@ -5,7 +5,9 @@
 //! it is: docs/PROFILES.md.
 
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
-use amber_train::{CnnConfig, Profile, TrainingConfig};
+use amber_train::{CnnConfig, MethodConfig, Profile, TrainingConfig};
+
+use crate::{Method, MethodSpec};
 use serde::{Deserialize, Serialize};
 
 /// A learning task of the paper.
@@ -53,6 +55,40 @@ pub fn cnn_config(task: Task, profile: Profile, resolution: usize) -> CnnConfig 
         }
     }
     config
+}
+
+/// The overrides a user merges into every run of an experiment: AMBER runs take `amber`, CNN
+/// runs `cnn` (JSON objects of config fields).
+pub struct Overrides<'a> {
+    pub amber: &'a serde_json::Value,
+    pub cnn: &'a serde_json::Value,
+}
+
+/// The configuration of one run of `task`: the task's profile (see [`amber_config`],
+/// [`cnn_config`]) with the method's labels, the seed, the user's overrides and the variant's.
+pub fn run_config(
+    task: Task,
+    profile: Profile,
+    spec: &MethodSpec,
+    seed: usize,
+    overrides: Overrides<'_>,
+) -> anyhow::Result<MethodConfig> {
+    let config = match spec.method {
+        Method::AmberMean | Method::AmberMax => {
+            let mut config = amber_config(task, profile);
+            config.aggregation = spec.method.aggregation();
+            config.seed = seed as u64;
+            MethodConfig::Amber(spec.patched(&config, overrides.amber)?)
+        }
+        Method::Cnn { resolution } => {
+            let mut config = cnn_config(task, profile, resolution);
+            config.aggregation = spec.method.aggregation();
+            config.seed = seed as u64;
+            MethodConfig::Cnn(spec.patched(&config, overrides.cnn)?)
+        }
+    };
+    config.validate()?;
+    Ok(config)
 }
 
 #[cfg(test)]
