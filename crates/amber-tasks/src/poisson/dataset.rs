@@ -21,7 +21,7 @@ use crate::TaskError;
 pub const GENERATOR_VERSION: u32 = 1;
 
 /// Name of the cache index inside a split directory.
-const INDEX_FILE: &str = "index.json";
+pub(super) const INDEX_FILE: &str = "index.json";
 
 /// A dataset split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -88,7 +88,8 @@ pub fn read_problem(path: &Path) -> Result<PoissonProblem, TaskError> {
     PoissonProblem::from_json(&bytes, path)
 }
 
-/// Reads every `NNN.json` problem file of a split directory, in name order.
+/// Reads every problem file (`*.json`, ours or the reference's format) of a directory in name
+/// order, all but a generated split's `index.json`; a directory without any is an error.
 pub fn read_split(dir: &Path) -> Result<Vec<PoissonProblem>, TaskError> {
     let io = |source| TaskError::Io { path: dir.into(), source };
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
@@ -96,11 +97,13 @@ pub fn read_split(dir: &Path) -> Result<Vec<PoissonProblem>, TaskError> {
         .map(|entry| entry.map(|e| e.path()))
         .collect::<Result<_, _>>()
         .map_err(io)?;
-    paths.retain(|p| {
-        p.extension().is_some_and(|e| e == "json")
-            && p.file_stem().is_some_and(|s| s.to_string_lossy().bytes().all(|b| b.is_ascii_digit()))
-    });
+    // Every JSON file is a problem but the split's own index (a generated split's cache record).
+    paths.retain(|p| p.extension().is_some_and(|e| e == "json") && !p.ends_with(super::dataset::INDEX_FILE));
     paths.sort();
+    if paths.is_empty() {
+        let source = std::io::Error::new(std::io::ErrorKind::NotFound, "no problem files (*.json) in this directory");
+        return Err(TaskError::Io { path: dir.into(), source });
+    }
     paths.iter().map(|p| read_problem(p)).collect()
 }
 
@@ -192,5 +195,18 @@ mod tests {
         assert!(err.to_string().contains("/nonexistent/001.json"));
         let err = PoissonProblem::from_json(b"{\"domain\": 3}", Path::new("b.json")).unwrap_err();
         assert!(err.to_string().starts_with("b.json"));
+    }
+
+    #[test]
+    fn a_directory_reads_every_problem_file_whatever_its_name() {
+        let dir = std::env::temp_dir().join(format!("amber-read-split-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let err = read_split(&dir).unwrap_err().to_string();
+        assert!(err.contains("no problem files"), "{err}");
+        problem().write(&dir.join("hole-plate.json")).unwrap();
+        problem().write(&dir.join("002.json")).unwrap();
+        std::fs::write(dir.join("index.json"), "{}").unwrap();
+        assert_eq!(read_split(&dir).unwrap().len(), 2);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
