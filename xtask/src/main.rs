@@ -14,6 +14,7 @@ mod label_rollouts;
 mod reference_distances;
 mod report;
 mod reproduce;
+mod ship_model;
 mod timing;
 
 use clap::{Parser, Subcommand};
@@ -41,6 +42,8 @@ enum Command {
     Reproduce(reproduce::Args),
     /// The paper's ablations on Poisson hard (results/ablate/).
     Ablate(reproduce::AblateArgs),
+    /// Copy a reproduction's trained model into models/NAME with its card.
+    ShipModel(ship_model::Args),
 }
 
 #[derive(Subcommand)]
@@ -78,6 +81,7 @@ fn main() -> anyhow::Result<()> {
         Command::Bench(Bench::Mpn(args)) => bench_mpn::run(args),
         Command::Bench(Bench::Cnn(args)) => bench_cnn::run(args),
         Command::Dataset(args) => dataset::run(args),
+        Command::ShipModel(args) => ship_model::run(args),
         Command::ReferenceDistances(args) => reference_distances::run(args),
         Command::LabelRollouts(args) => label_rollouts::run(args),
         Command::Reproduce(args) => reproduce::run(args),

@@ -1,7 +1,7 @@
 //! The `amber` command line.
 //!
-//! `amber mesh` turns a geometry and a sizing field into a mesh file or picture; `amber train`
-//! trains AMBER; `amber generate` meshes a problem with a trained model.
+//! `amber mesh` meshes a geometry with a trained model (or a given sizing field) into a mesh file
+//! or picture; `amber train` trains AMBER.
 
 mod mesh;
 mod train;
@@ -17,12 +17,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Mesh a 2D domain with a sizing field; write .vtu, .msh, .json or .png.
+    /// Mesh a geometry with a trained model (or a sizing field); write .vtu, .msh, .json or .png.
     Mesh(mesh::MeshArgs),
     /// Train AMBER (resumes a killed run in the same --out directory).
     Train(train::TrainArgs),
-    /// Mesh a problem with a trained model: T generation steps from its initial mesh.
-    Generate(train::GenerateArgs),
 }
 
 #[global_allocator]
@@ -37,6 +35,5 @@ fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Mesh(args) => mesh::run(args),
         Command::Train(args) => train::train(args),
-        Command::Generate(args) => train::generate(args),
     }
 }

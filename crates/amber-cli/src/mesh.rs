@@ -1,42 +1,250 @@
-//! `amber mesh`: a geometry plus a sizing field in, a mesh file or picture out.
+//! `amber mesh`: a geometry in, a mesh out, its sizes from a trained model (`--model`) or a given
+//! sizing field (`--size`).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use amber_mesh::{Mesh2, MeshData, read_mesh_with_data, write_mesh};
+use amber_experiments::{ModelCard, Task, resolve_model};
+use amber_mesh::{Mesh, Mesh2, Mesh3, MeshData, read_mesh, read_mesh_with_data, write_mesh};
+use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
-use amber_plot::{RenderOptions, render_png};
+use amber_plot::{RenderOptions, View, render_png, render_surface_png};
+use amber_tasks::part::{FEATURE_ANGLE_DEGREES, SolidPart, read_polygon_domain, read_solid_surface};
+use amber_tasks::poisson::{PoissonPart, read_part, read_problem};
+use amber_tasks::{Domain, WithExpert};
+use amber_train::{ElementTarget, GeneratedStep, MeshMetrics, Reference, TrainedModel};
 use anyhow::{Context, bail};
 use clap::Args;
 
 #[derive(Args)]
 pub struct MeshArgs {
-    /// `lshape`, `square`, or a JSON file `{"outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}`.
-    #[arg(long, default_value = "lshape")]
-    domain: String,
-    /// Re-entrant corner of the L-shape.
+    /// The geometry: `lshape` (with --corner), `square`, a polygon JSON
+    /// `{"outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}`, a closed surface (.stl, .obj), or
+    /// a 2D or 3D mesh file whose boundary is the geometry. With --problem it may be left out: the
+    /// problem's own domain is meshed.
+    geometry: Option<String>,
+    /// Re-entrant corner of the `lshape` geometry.
     #[arg(long, value_parser = parse_point, default_value = "0.5,0.5")]
     corner: [f64; 2],
-    /// A constant size (edge length), or a mesh file (.vtu, .msh, .json) whose element sizes
-    /// define a piecewise-constant field (a `size` cell array in a .vtu overrides them).
+    /// A trained model: a shipped model's name (`poisson-hard`, `console`: the `models/` directory
+    /// of the repository the binary was built from, or `$AMBER_MODELS`) or a model or run
+    /// directory.
+    #[arg(long, conflicts_with = "size", required_unless_present = "size")]
+    model: Option<String>,
+    /// Instead of a model: a constant size (edge length), or a mesh file whose element sizes define
+    /// a piecewise-constant field (a `size` cell array overrides them). 2D geometries only.
     #[arg(long, allow_hyphen_values = true)]
-    size: String,
+    size: Option<String>,
+    /// Generation steps (default: the model's own number).
+    #[arg(long)]
+    steps: Option<usize>,
+    /// Aim the final mesh at this many elements (within ±10 %): the last step's predicted field
+    /// keeps its shape and is scaled by one factor.
+    #[arg(long)]
+    elements: Option<usize>,
+    /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,
+    /// and its domain when no geometry is given; its expert mesh, when present, is the default
+    /// --expert).
+    #[arg(long)]
+    problem: Option<PathBuf>,
+    /// The expert's mesh of this geometry: each step is scored against it (normalised DCD, DCD,
+    /// volume difference).
+    #[arg(long)]
+    expert: Option<PathBuf>,
+    /// Also write every step's mesh (`step<t>.vtu`) and picture (`step<t>.png`) here.
+    #[arg(long)]
+    every_step: Option<PathBuf>,
+    /// Surfaces without CAD faces (a plain STL, a mesh boundary) are split into faces at edges
+    /// sharper than this many degrees.
+    #[arg(long, default_value_t = FEATURE_ANGLE_DEGREES)]
+    feature_angle: f64,
     /// Refuse to build more elements than this.
     #[arg(long, default_value_t = 5_000_000)]
     max_elements: usize,
-    /// Output: .vtu (ParaView), .msh (gmsh 4.1), .json, or .png (coloured by element size).
+    /// Output: .vtu (ParaView), .msh (gmsh 4.1), .json, or .png (a picture coloured by element size).
     #[arg(short, long)]
     output: PathBuf,
 }
 
 pub fn run(args: MeshArgs) -> anyhow::Result<()> {
-    let domain = parse_domain(&args.domain, &args.corner)?;
-    let params = Mesh2dParams::default().with_max_elements(args.max_elements);
+    match &args.model {
+        Some(model) => with_model(&args, model),
+        None => with_size(&args, args.size.as_deref().expect("clap requires --size without --model")),
+    }
+}
+
+/// `--model`: the model's task decides what the geometry becomes.
+fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
+    let shipped = std::env::var_os("AMBER_MODELS")
+        .map_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models"), PathBuf::from);
+    let dir = resolve_model(model, &shipped)?;
+    let card = ModelCard::read(&dir)?;
+    let mut trained = TrainedModel::load(&dir).with_context(|| format!("{}: cannot load the model", dir.display()))?;
+    // A user's geometry is meshed whatever the field asks for: over the budget, it is scaled to it.
+    trained.limits_mut().scale_to_budget = true;
+    let steps = args.steps.unwrap_or(card.inference_steps);
+    if steps == 0 {
+        bail!("--steps must be at least 1");
+    }
+    match card.task {
+        Task::Poisson => {
+            let problem = args.problem.as_deref().with_context(|| {
+                format!("the model `{model}` reads the load f of a Poisson problem: give it with --problem FILE.json")
+            })?;
+            let mut part = read_part(problem)?;
+            if args.geometry.is_some() {
+                part = PoissonPart::new(planar_domain(args)?, part.load, None, part.quadrature_order)?;
+            }
+            let expert = match &args.expert {
+                Some(path) => Some(read_mesh::<2>(path)?),
+                None if args.geometry.is_none() => read_problem(problem).ok().map(|p| p.expert_mesh),
+                None => None,
+            };
+            mesh_domain(args, &trained, part, expert, steps)
+        }
+        Task::Console => {
+            let geometry = args.geometry.as_deref().context("give the geometry to mesh: a closed STL or a tet mesh")?;
+            let path = Path::new(geometry);
+            let surface = read_solid_surface(path, args.feature_angle)?;
+            let name = path.file_stem().map_or_else(|| geometry.to_owned(), |s| s.to_string_lossy().into_owned());
+            let part = SolidPart::new(name, surface, card.initial_size)
+                .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
+            let expert = args.expert.as_deref().map(read_mesh::<3>).transpose()?;
+            mesh_domain(args, &trained, part, expert, steps)
+        }
+    }
+}
+
+/// Rolls the model out on `domain`, scores each step against `expert` when there is one, and
+/// writes the outputs.
+fn mesh_domain<const D: usize, P: Domain<D>>(
+    args: &MeshArgs,
+    model: &TrainedModel,
+    domain: P,
+    expert: Option<Mesh<D>>,
+    steps: usize,
+) -> anyhow::Result<()>
+where
+    Mesh<D>: Picture,
+{
     let start = Instant::now();
-    let (mesh, report) = match args.size.parse::<f64>() {
+    let target = args.elements.map(|elements| ElementTarget { elements, max_elements: args.max_elements });
+    let generated = model.generate(&domain, steps, target)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let scored = expert.map(|expert_mesh| WithExpert { domain, expert_mesh });
+    let reference = scored.as_ref().map(|p| Reference::new(p, model.limits())).transpose()?;
+    let metrics: Vec<Option<MeshMetrics>> = generated
+        .iter()
+        .map(|step| match (&scored, &reference) {
+            (Some(p), Some(r)) => MeshMetrics::of(&step.mesh, &p.expert_mesh, r).map(Some),
+            _ => Ok(None),
+        })
+        .collect::<Result<_, _>>()?;
+    if let Some(dir) = &args.every_step {
+        write_steps(dir, &generated)?;
+    }
+    let last = &generated.last().expect("at least one step").mesh;
+    write_output(last, &args.output)?;
+    for (t, (step, metrics)) in generated.iter().zip(&metrics).enumerate() {
+        let score = metrics.map_or(String::new(), |m| {
+            format!(
+                ", normalised DCD {:.3}, DCD {:.4}, volume difference {:.3e}",
+                m.normalised_dcd, m.dcd, m.volume_difference
+            )
+        });
+        eprintln!("step {}: {} elements{score}", t + 1, step.mesh.num_elements());
+    }
+    if let (Some(p), Some(r)) = (&scored, &reference) {
+        eprintln!(
+            "expert: {} elements; normalised by d(M⁰) {:.4} and d(M̂) {:.4}",
+            p.expert_mesh.num_elements(),
+            r.initial_dcd,
+            r.reconstruction_dcd
+        );
+    }
+    eprintln!("{steps} steps in {seconds:.2} s; wrote {}", args.output.display());
+    Ok(())
+}
+
+/// Each step's mesh as `step<t>.vtu` (element sizes) and `step<t>.png`, on one colour scale.
+fn write_steps<const D: usize>(dir: &Path, steps: &[GeneratedStep<D>]) -> anyhow::Result<()>
+where
+    Mesh<D>: Picture,
+{
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    let range =
+        steps.iter().flat_map(|s| s.mesh.sizes()).fold((f64::INFINITY, 0.0f64), |(lo, hi), h| (lo.min(h), hi.max(h)));
+    for (t, step) in steps.iter().enumerate() {
+        let sizes = step.mesh.sizes();
+        write_mesh(
+            &step.mesh,
+            dir.join(format!("step{}.vtu", t + 1)),
+            &MeshData::new().with_cell("size", sizes.clone()),
+        )?;
+        let title = format!("step {}: {} elements", t + 1, step.mesh.num_elements());
+        let options = RenderOptions { title: Some(title), log_scale: true, range: Some(range), ..Default::default() };
+        step.mesh.picture(&sizes, &options, &dir.join(format!("step{}.png", t + 1)))?;
+    }
+    Ok(())
+}
+
+/// A picture of a mesh coloured by per-element values: the mesh itself in 2D, its boundary
+/// surface in 3D.
+trait Picture {
+    fn picture(&self, values: &[f64], options: &RenderOptions, path: &Path) -> anyhow::Result<()>;
+}
+
+impl Picture for Mesh2 {
+    fn picture(&self, values: &[f64], options: &RenderOptions, path: &Path) -> anyhow::Result<()> {
+        Ok(render_png(self, values, options, path)?)
+    }
+}
+
+impl Picture for Mesh3 {
+    fn picture(&self, values: &[f64], options: &RenderOptions, path: &Path) -> anyhow::Result<()> {
+        Ok(render_surface_png(self, values, options, View { azimuth_deg: 35.0, elevation_deg: 30.0 }, path)?)
+    }
+}
+
+/// Writes `mesh` to `output` by extension, with its element sizes; `.png` is a picture.
+fn write_output<const D: usize>(mesh: &Mesh<D>, output: &Path) -> anyhow::Result<()>
+where
+    Mesh<D>: Picture,
+{
+    let sizes = mesh.sizes();
+    match output.extension().and_then(|e| e.to_str()) {
+        Some("png") => {
+            let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
+            mesh.picture(&sizes, &options, output)
+        }
+        _ => Ok(write_mesh(mesh, output, &MeshData::new().with_cell("size", sizes))?),
+    }
+}
+
+/// `--size`: a 2D geometry meshed from a given field, or a 3D one from a constant size.
+fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
+    let geometry = args.geometry.as_deref().unwrap_or("lshape");
+    let start = Instant::now();
+    if is_solid(geometry) {
+        let h: f64 = size.parse().with_context(|| format!("--size {size}: a 3D geometry takes a constant size"))?;
+        let surface = read_solid_surface(Path::new(geometry), args.feature_angle)?;
+        let params = Mesh3dParams::default().with_max_elements(args.max_elements);
+        let mesh = generate_3d(&surface, &ConstantSize(h), &params).context("mesh generation failed")?;
+        write_output(&mesh, &args.output)?;
+        eprintln!(
+            "{} tetrahedra in {:.3} s; wrote {}",
+            mesh.num_elements(),
+            start.elapsed().as_secs_f64(),
+            args.output.display()
+        );
+        return Ok(());
+    }
+    let domain = planar_domain(args)?;
+    let params = Mesh2dParams::default().with_max_elements(args.max_elements);
+    let (mesh, report) = match size.parse::<f64>() {
         Ok(h) => mesh_with(&domain, &ConstantSize(h), &params)?,
         Err(_) => {
-            let (field_mesh, sizes) = read_sizing_mesh(Path::new(&args.size))?;
+            let (field_mesh, sizes) = read_sizing_mesh(Path::new(size))?;
             mesh_with(&domain, &MeshSizing::new(&field_mesh, sizes), &params)?
         }
     };
@@ -53,6 +261,14 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// Whether `geometry` names a solid: a surface file, or a mesh file holding tetrahedra.
+fn is_solid(geometry: &str) -> bool {
+    let path = Path::new(geometry);
+    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    matches!(extension.as_deref(), Some("stl" | "obj"))
+        || (extension.as_deref() != Some("json") && read_mesh::<3>(path).is_ok())
 }
 
 fn mesh_with<F: SizingField<2>>(
@@ -72,14 +288,12 @@ fn parse_point(text: &str) -> Result<[f64; 2], String> {
     }
 }
 
-fn parse_domain(domain: &str, corner: &[f64; 2]) -> anyhow::Result<PolygonDomain> {
-    Ok(match domain {
-        "lshape" => PolygonDomain::lshape(*corner)?,
+/// The 2D geometry argument as a domain (the L-shape when none is given).
+fn planar_domain(args: &MeshArgs) -> anyhow::Result<PolygonDomain> {
+    Ok(match args.geometry.as_deref().unwrap_or("lshape") {
+        "lshape" => PolygonDomain::lshape(args.corner)?,
         "square" => PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![])?,
-        path => {
-            let text = std::fs::read_to_string(path).with_context(|| format!("{path}: cannot read the domain file"))?;
-            serde_json::from_str(&text).with_context(|| format!("{path}: not a valid domain"))?
-        }
+        path => read_polygon_domain(Path::new(path))?,
     })
 }
 
@@ -96,16 +310,4 @@ fn read_sizing_mesh(path: &Path) -> anyhow::Result<(Mesh2, Vec<f64>)> {
         );
     }
     Ok((mesh, sizes))
-}
-
-fn write_output(mesh: &Mesh2, output: &Path) -> anyhow::Result<()> {
-    let sizes = mesh.sizes();
-    match output.extension().and_then(|e| e.to_str()) {
-        Some("png") => {
-            let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
-            render_png(mesh, &sizes, &options, output)?
-        }
-        _ => write_mesh(mesh, output, &MeshData::new().with_cell("size", sizes))?,
-    }
-    Ok(())
 }

@@ -1,14 +1,12 @@
 //! `amber train`: trains AMBER on a task with a named profile into a run directory (resumes a
-//! killed run there), and `amber generate`: applies a trained model to a problem.
+//! killed run there) and writes the model's card.
 
 use std::path::PathBuf;
 
-use amber_experiments::{Method, amber_config, merge_json, train_poisson};
-use amber_mesh::{MeshData, write_mesh};
-use amber_plot::{RenderOptions, render_png};
+use amber_experiments::{Method, ModelCard, amber_config, commit, merge_json, train_poisson};
 use amber_stdx::read_json;
-use amber_tasks::poisson::{Difficulty, read_problem};
-use amber_train::{AmberModel, Evaluation, MODEL_DIR, MethodConfig, Profile, StepStatus};
+use amber_tasks::poisson::{Difficulty, INITIAL_SIZE};
+use amber_train::{MODEL_DIR, MethodConfig, Profile};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 
@@ -66,67 +64,29 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
         config.steps = steps;
     }
     let label = format!("{} {} seed {}", args.method, args.difficulty, args.seed);
+    let inference_steps = config.inference_steps;
     let config = MethodConfig::Amber(config);
     config.validate()?;
     let seconds = train_poisson(&config, args.difficulty, &args.data, &args.manifest, &args.out, &label)?;
-    println!("trained in {seconds:.0} s; model in {}", args.out.join(MODEL_DIR).display());
-    Ok(())
-}
-
-#[derive(Args)]
-pub struct GenerateArgs {
-    /// A trained model directory (`<run>/model`) or a checkpoint directory.
-    #[arg(long)]
-    model: PathBuf,
-    /// A Poisson problem file (ours or the reference's JSON format) with its expert mesh.
-    #[arg(long)]
-    problem: PathBuf,
-    /// Generation steps T.
-    #[arg(long, default_value_t = 5)]
-    steps: usize,
-    /// Output directory: `step<t>.vtu` and `step<t>.png` per step and `metrics.json`.
-    #[arg(long)]
-    out: PathBuf,
-}
-
-pub fn generate(args: GenerateArgs) -> anyhow::Result<()> {
-    let model =
-        AmberModel::load(&args.model).with_context(|| format!("{}: cannot load the model", args.model.display()))?;
-    let problem = read_problem(&args.problem)?;
-    let problems = [problem];
-    let evaluation = Evaluation::new(&problems, &model.predictor.limits)?;
-    let (rollouts, summary) = evaluation.run(&model.sizing(), args.steps)?;
-    let rollout = &rollouts[0];
-    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
-    let range = rollout
-        .steps
-        .iter()
-        .flat_map(|s| s.mesh.sizes())
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), h| (lo.min(h), hi.max(h)));
-    for (t, step) in rollout.steps.iter().enumerate() {
-        let sizes = step.mesh.sizes();
-        let mut data = MeshData::default();
-        data.cell.insert("size".into(), sizes.clone());
-        write_mesh(&step.mesh, args.out.join(format!("step{}.vtu", t + 1)), &data)?;
-        let title = format!(
-            "step {}: {} elements, normalised DCD {:.3}{}",
-            t + 1,
-            step.mesh.num_elements(),
-            step.metrics.normalised_dcd,
-            if step.status == StepStatus::Meshed { String::new() } else { format!(" ({:?})", step.status) }
-        );
-        let options = RenderOptions { title: Some(title), log_scale: true, range: Some(range), ..Default::default() };
-        render_png(&step.mesh, &sizes, &options, args.out.join(format!("step{}.png", t + 1)))?;
-        println!(
-            "step {}: {} elements (expert {}), normalised DCD {:.3}, raw DCD {:.4}",
-            t + 1,
-            step.mesh.num_elements(),
-            problems[0].expert_mesh.num_elements(),
-            step.metrics.normalised_dcd,
-            step.metrics.dcd
-        );
-    }
-    amber_experiments::write_json(&args.out.join("metrics.json"), &summary)?;
-    println!("wrote {}/step*.vtu, step*.png, metrics.json", args.out.display());
+    let model = args.out.join(MODEL_DIR);
+    let card = ModelCard {
+        task: amber_experiments::Task::Poisson,
+        method: args.method.to_string(),
+        inference_steps,
+        initial_size: INITIAL_SIZE,
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        data: format!(
+            "{} problems of {}, difficulty {}, seed {}",
+            args.data.display(),
+            args.manifest.display(),
+            args.difficulty,
+            args.seed
+        ),
+        commit: commit().to_owned(),
+        training_seconds: seconds,
+        evaluation: None,
+    };
+    card.write(&model)?;
+    println!("trained in {seconds:.0} s; model in {}", model.display());
     Ok(())
 }

@@ -10,7 +10,8 @@ fn amber() -> Command {
 fn meshes_an_lshape_and_remeshes_from_the_result() {
     let dir = tempfile::tempdir().unwrap();
     let first = dir.path().join("first.vtu");
-    let status = amber().args(["mesh", "--corner", "0.3,0.6", "--size", "0.05", "-o"]).arg(&first).status().unwrap();
+    let status =
+        amber().args(["mesh", "lshape", "--corner", "0.3,0.6", "--size", "0.05", "-o"]).arg(&first).status().unwrap();
     assert!(status.success());
     let mesh = amber_mesh::read_mesh::<2>(&first).unwrap();
     assert!(mesh.num_elements() > 300);
@@ -91,35 +92,70 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
         .collect();
     assert_eq!(steps, (1..=40).collect::<Vec<_>>(), "every step logged once, across the kill");
 
+    // The model meshes a problem's domain from its load alone, scored against the problem's expert.
     let problem_file = data.join("easy/val/000.json");
     let out = dir.path().join("generated");
+    let final_mesh = dir.path().join("final.msh");
     let output = amber()
-        .args(["generate", "--steps", "2", "--model"])
-        .arg(run.join("model"))
+        .args(["mesh", "--steps", "2", "--model"])
+        .arg(&run)
         .arg("--problem")
         .arg(&problem_file)
-        .arg("--out")
+        .arg("--every-step")
         .arg(&out)
-        .output()
-        .unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    for file in ["step1.vtu", "step2.vtu", "step1.png", "step2.png", "metrics.json"] {
-        assert!(out.join(file).exists(), "{file} missing");
-    }
-    let mesh = amber_mesh::read_mesh::<2>(out.join("step2.vtu")).unwrap();
-    let problem = amber_tasks::poisson::read_problem(&problem_file).unwrap();
-    assert!((mesh.total_volume() - problem.expert_mesh.total_volume()).abs() < 1e-9);
-    let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();
-    assert_eq!(metrics["steps"].as_array().unwrap().len(), 2);
-
-    // A missing model is an error with a message, not a panic.
-    let output = amber()
-        .args(["generate", "--model", "/nonexistent", "--problem"])
-        .arg(&problem_file)
-        .arg("--out")
-        .arg(&out)
+        .arg("-o")
+        .arg(&final_mesh)
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success() && stderr.contains("/nonexistent") && !stderr.contains("panicked"), "{stderr}");
+    assert!(output.status.success(), "{stderr}");
+    for file in ["step1.vtu", "step2.vtu", "step1.png", "step2.png"] {
+        assert!(out.join(file).exists(), "{file} missing");
+    }
+    assert!(stderr.contains("step 2:") && stderr.contains("normalised DCD"), "{stderr}");
+    let mesh = amber_mesh::read_mesh::<2>(&final_mesh).unwrap();
+    let problem = amber_tasks::poisson::read_problem(&problem_file).unwrap();
+    assert!((mesh.total_volume() - problem.expert_mesh.total_volume()).abs() < 1e-9);
+
+    // The budget knob: the final mesh has the requested element count within ±10 %, on a domain
+    // the model has never seen (a square with a hole, the problem's load).
+    let square = dir.path().join("holed.json");
+    std::fs::write(
+        &square,
+        r#"{"outer": [[0,0],[1,0],[1,1],[0,1]], "holes": [[[0.4,0.4],[0.4,0.6],[0.6,0.6],[0.6,0.4]]]}"#,
+    )
+    .unwrap();
+    for elements in [300usize, 1200] {
+        let output = amber()
+            .arg("mesh")
+            .arg(&square)
+            .args(["--steps", "2", "--elements", &elements.to_string(), "--model"])
+            .arg(&run)
+            .arg("--problem")
+            .arg(&problem_file)
+            .arg("-o")
+            .arg(&final_mesh)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        let mesh = amber_mesh::read_mesh::<2>(&final_mesh).unwrap();
+        let ratio = mesh.num_elements() as f64 / elements as f64;
+        assert!((0.9..=1.1).contains(&ratio), "{} elements for {elements}", mesh.num_elements());
+        assert!((mesh.total_volume() - 0.96).abs() < 1e-9);
+    }
+
+    // A missing model, or a Poisson model without its load, is an error with a message.
+    for args in [vec!["--model", "/nonexistent", "--problem"], vec!["square", "--model"]] {
+        let mut command = amber();
+        command.arg("mesh").args(&args);
+        if args.contains(&"--problem") {
+            command.arg(&problem_file);
+        } else {
+            command.arg(&run);
+        }
+        let output = command.arg("-o").arg(&final_mesh).output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success() && !stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(stderr.contains("/nonexistent") || stderr.contains("--problem"), "{args:?}: {stderr}");
+    }
 }

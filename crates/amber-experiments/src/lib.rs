@@ -6,6 +6,7 @@
 //! in one schema ([`ExperimentResults`]), `table.md` with the paper's numbers beside ours, and
 //! PNG charts and mesh galleries. Progress goes to the terminal as bars and lines.
 
+mod card;
 mod console;
 mod method;
 mod outputs;
@@ -17,6 +18,7 @@ mod results;
 mod run;
 mod table;
 
+pub use card::{CARD_FILE, CardEvaluation, ModelCard, resolve_model};
 pub use console::ConsoleExperiment;
 pub use method::{Method, MethodSpec, Variant};
 pub use poisson::{PoissonExperiment, train_poisson};

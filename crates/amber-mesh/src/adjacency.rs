@@ -78,6 +78,25 @@ impl FacetAdjacency {
             .map(|(k, _)| (k / self.nodes_per_element, k % self.nodes_per_element))
     }
 
+    /// The boundary facets as vertex lists oriented outwards (2D: edges with the domain on their
+    /// left, so outer rings run counter-clockwise and holes clockwise; 3D: triangles whose
+    /// right-hand normal points out of the solid), in element order. Assumes positively oriented
+    /// elements, as every [`Mesh`] has.
+    pub fn oriented_boundary_facets<const D: usize>(&self, mesh: &Mesh<D>) -> Vec<[u32; D]> {
+        // The facet opposite local vertex `i`, listed so that it is outward for a positive simplex.
+        let local: &[&[usize]] = match D {
+            2 => &[&[1, 2], &[2, 0], &[0, 1]],
+            3 => &[&[1, 2, 3], &[0, 3, 2], &[0, 1, 3], &[0, 2, 1]],
+            _ => unreachable!("meshes are 2D or 3D"),
+        };
+        self.boundary_facets()
+            .map(|(e, opposite)| {
+                let cell = mesh.element(e);
+                std::array::from_fn(|k| cell[local[opposite][k]])
+            })
+            .collect()
+    }
+
     /// Flags every vertex that lies on a boundary facet.
     pub fn boundary_vertices<const D: usize>(&self, mesh: &Mesh<D>) -> Vec<bool> {
         let mut on_boundary = vec![false; mesh.num_vertices()];
@@ -112,6 +131,28 @@ mod tests {
         assert_eq!(adj.boundary_facets().count(), 4);
         assert_eq!(adj.num_interior_facets(), 1);
         assert!(adj.boundary_vertices(&m).iter().all(|&b| b));
+    }
+
+    /// Outward facets enclose the mesh: the shoelace sum over the boundary edges (2D) and the
+    /// divergence-theorem sum over the boundary triangles (3D) give the total volume.
+    #[test]
+    fn oriented_boundary_facets_enclose_the_mesh() {
+        let m = Mesh2::new(vec![[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]], vec![0, 1, 2, 0, 2, 3]).unwrap();
+        let edges = FacetAdjacency::new(&m).unwrap().oriented_boundary_facets(&m);
+        let v = m.vertices();
+        let area: f64 = edges
+            .iter()
+            .map(|&[a, b]| v[a as usize][0] * v[b as usize][1] - v[b as usize][0] * v[a as usize][1])
+            .sum::<f64>()
+            / 2.0;
+        assert_eq!((edges.len(), area), (4, 2.0));
+        let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -2.0]];
+        let m = Mesh3::new_reoriented(v, vec![0, 1, 2, 3, 0, 2, 1, 4]).unwrap();
+        let faces = FacetAdjacency::new(&m).unwrap().oriented_boundary_facets(&m);
+        let p = |i: u32| nalgebra::Vector3::from(m.vertices()[i as usize]);
+        let volume: f64 = faces.iter().map(|&[a, b, c]| p(a).dot(&p(b).cross(&p(c))) / 6.0).sum();
+        assert_eq!(faces.len(), 6);
+        assert!((volume - m.total_volume()).abs() < 1e-15, "{volume} vs {}", m.total_volume());
     }
 
     #[test]

@@ -1,5 +1,8 @@
 //! 2D geometry: polygons with holes, and the L-shape of the Poisson task.
 
+use std::collections::{HashMap, HashSet};
+
+use amber_mesh::{FacetAdjacency, Mesh2};
 use serde::{Deserialize, Serialize};
 
 use crate::MeshgenError;
@@ -48,6 +51,48 @@ impl PolygonDomain {
             return Err(MeshgenError::InvalidDomain(format!("L-shape corner {corner:?} must lie inside (0, 1)²")));
         }
         Self::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, py], [px, py], [px, 1.0], [0.0, 1.0]], vec![])
+    }
+
+    /// The domain a mesh covers: its boundary edges chained into rings, vertices where the
+    /// boundary runs straight on dropped (so a polygon meshed finely gives back its corners, and
+    /// the old mesh's boundary spacing does not constrain a new one), the ring of largest area the
+    /// outer one and the others its holes. A boundary that is not a set of disjoint simple loops
+    /// (two components, a vertex where rings touch) is an error.
+    pub fn from_mesh_boundary(mesh: &Mesh2) -> Result<Self, MeshgenError> {
+        let edges = FacetAdjacency::new(mesh)?.oriented_boundary_facets(mesh);
+        let mut next = HashMap::with_capacity(edges.len());
+        for &[a, b] in &edges {
+            if next.insert(a, b).is_some() {
+                let at = mesh.vertices()[a as usize];
+                return Err(MeshgenError::InvalidDomain(format!(
+                    "the mesh boundary touches itself at vertex {a} {at:?}: not a set of simple loops"
+                )));
+            }
+        }
+        let mut rings: Vec<Vec<[f64; 2]>> = Vec::new();
+        let mut visited = HashSet::with_capacity(edges.len());
+        for &[start, _] in &edges {
+            if !visited.insert(start) {
+                continue;
+            }
+            let mut ring = vec![start];
+            let mut v = next[&start];
+            while v != start {
+                visited.insert(v);
+                ring.push(v);
+                v = next[&v];
+            }
+            rings.push(drop_straight_vertices(ring.iter().map(|&v| mesh.vertices()[v as usize]).collect()));
+        }
+        let outer = (0..rings.len()).max_by(|&a, &b| ring_area(&rings[a]).total_cmp(&ring_area(&rings[b])));
+        let outer = rings.swap_remove(outer.expect("a mesh has a boundary"));
+        if let Some(ring) = rings.iter().find(|ring| ring_area(ring) > 0.0) {
+            return Err(MeshgenError::InvalidDomain(format!(
+                "the mesh has more than one component (a second outer boundary starts at {:?})",
+                ring[0]
+            )));
+        }
+        Self::new(outer, rings)
     }
 
     /// The outer ring.
@@ -222,9 +267,47 @@ fn segments_intersect(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> boo
     (d1 == 0.0 && on(c, d, a)) || (d2 == 0.0 && on(c, d, b)) || (d3 == 0.0 && on(a, b, c)) || (d4 == 0.0 && on(a, b, d))
 }
 
+/// `ring` without the vertices where it runs straight on: the turn there is below 1e-9 radians,
+/// far below any corner a user draws, far above rounding in coordinates of a straight line.
+fn drop_straight_vertices(ring: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+    let n = ring.len();
+    let turns = |i: usize| {
+        let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+        let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
+        let cross = u[0] * v[1] - u[1] * v[0];
+        let dot = u[0] * v[0] + u[1] * v[1];
+        cross.atan2(dot).abs() > 1e-9
+    };
+    let kept: Vec<[f64; 2]> = (0..n).filter(|&i| turns(i)).map(|i| ring[i]).collect();
+    if kept.len() >= 3 { kept } else { ring }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A fine mesh of a polygon with a hole gives back the polygon: its corners only (the
+    /// vertices along straight sides are dropped), the hole as a hole.
+    #[test]
+    fn mesh_boundaries_give_back_their_polygons() {
+        let outer = vec![[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]];
+        let hole = vec![[0.25, 0.25], [0.25, 0.5], [0.5, 0.5], [0.5, 0.25]];
+        let domain = PolygonDomain::new(outer.clone(), vec![hole]).unwrap();
+        let mesh = crate::uniform_mesh_2d(&domain, 0.05, &Default::default()).unwrap();
+        let back = PolygonDomain::from_mesh_boundary(&mesh).unwrap();
+        assert_eq!(back.outer().len(), 6);
+        assert!(outer.iter().all(|p| back.outer().contains(p)));
+        assert_eq!(back.holes().len(), 1);
+        assert_eq!(back.holes()[0].len(), 4);
+        assert!((back.area() - domain.area()).abs() < 1e-12);
+        // Two separate squares are not one domain.
+        let two = Mesh2::new(
+            vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [2.0, 0.0], [3.0, 0.0], [2.0, 1.0]],
+            vec![0, 1, 2, 3, 4, 5],
+        )
+        .unwrap();
+        assert!(PolygonDomain::from_mesh_boundary(&two).unwrap_err().to_string().contains("more than one component"));
+    }
 
     #[test]
     fn lshape_area_and_containment() {

@@ -23,6 +23,9 @@ pub enum TaskError {
     /// The domain polygon of a problem file is not an L-shape.
     #[error("{path}: field `domain.polygon`: {message}")]
     Polygon { path: PathBuf, message: String },
+    /// A geometry file does not describe a domain (the message says why).
+    #[error("{path}: {message}")]
+    Geometry { path: PathBuf, message: String },
     /// A dataset manifest does not define what was asked.
     #[error("{path}: {message}")]
     Manifest { path: PathBuf, message: String },

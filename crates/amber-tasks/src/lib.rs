@@ -1,7 +1,8 @@
-//! The learning tasks: what a task is ([`Problem`]: initial and expert mesh, input columns on any
-//! mesh of its domain, re-meshing from a sizing field), what every task shares (mesh states with
-//! their graphs, labels, one generation step under h_min and the element budget), and the tasks
-//! themselves beside their data. Poisson (spec §1): the random L-shape and Gaussian-mixture load,
+//! The learning tasks: what a task is ([`Domain`]: initial mesh, input columns on any mesh of the
+//! domain, re-meshing from a sizing field; [`Problem`]: a domain with its expert mesh), what every
+//! task shares (mesh states with their graphs, labels, one generation step under h_min and the
+//! element budget, meshing to a requested element count), geometry-only domains
+//! ([`part::SolidPart`]), and the tasks themselves beside their data. Poisson (spec §1): the random L-shape and Gaussian-mixture load,
 //! M⁰, the expert mesh, one JSON file per problem (readable from the reference's format too),
 //! the dataset splits of `datasets/poisson.json` with a content-hash cache. Console (spec §9): the
 //! expert `.nas` meshes and reference surfaces of the car-seat parts.
@@ -11,11 +12,12 @@
 
 pub mod console;
 mod error;
+pub mod part;
 pub mod poisson;
 mod problem;
 
 pub use error::TaskError;
 pub use problem::{
-    Column, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step, labels,
-    with_inputs,
+    Column, Domain, ELEMENT_COUNT_TOLERANCE, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError,
+    StepOutcome, WithExpert, generation_step, labels, mesh_to_element_count, with_inputs,
 };

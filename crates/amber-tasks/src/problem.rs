@@ -1,9 +1,11 @@
-//! What the training and inference loops need to know about a learning task: a [`Problem`] has an
-//! initial and an expert mesh, computes its per-element input columns on any mesh of its domain,
-//! and re-meshes its domain from a per-element sizing field. Around it, what every task shares: a
-//! mesh with its columns and graph ([`MeshState`]), the labels (the expert's sizing field projected
-//! onto a mesh), and one generation step under h_min and the element budget ([`MeshLimits`]).
-//! Each task implements the trait beside its data (`poisson`, `console`).
+//! What the training and inference loops need to know about a learning task. A [`Domain`] is what
+//! inference needs: an initial mesh, the per-element input columns on any mesh of the domain, and
+//! re-meshing from a per-element sizing field. A [`Problem`] is a domain with its expert's mesh,
+//! what training and evaluation need. Around them, what every task shares: a mesh with its
+//! columns and graph ([`MeshState`]), the labels (the expert's sizing field projected onto a
+//! mesh), and one generation step under h_min and the element budget ([`MeshLimits`]), or to a
+//! requested element count ([`mesh_to_element_count`]). Each task implements the traits beside
+//! its data (`poisson`, `console`); geometry-only domains live in `part`.
 
 use amber_fem::FemError;
 use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, NodeFeature, project_expert_sizing};
@@ -39,8 +41,9 @@ pub struct Column {
     pub values: Vec<f64>,
 }
 
-/// One problem of a learning task in `D` dimensions.
-pub trait Problem<const D: usize>: Sync {
+/// A domain of a learning task in `D` dimensions: its geometry and task inputs, everything a
+/// trained model needs to mesh it (no expert mesh).
+pub trait Domain<const D: usize>: Sync {
     /// The node and edge features of this task's graphs (the same for all its problems).
     fn feature_set(&self) -> FeatureSet;
     /// Names of the columns this task computes beyond its feature set, which a model may take as
@@ -50,14 +53,54 @@ pub trait Problem<const D: usize>: Sync {
     }
     /// M⁰, the start of every rollout.
     fn initial_mesh(&self) -> &Mesh<D>;
-    /// M*, the expert's mesh the labels come from.
-    fn expert_mesh(&self) -> &Mesh<D>;
     /// The per-element columns the feature set names, on `mesh` (a mesh of this problem's
     /// domain); the geometric features are computed by the graph.
     fn columns(&self, mesh: &Mesh<D>) -> Result<Vec<Column>, ProblemError>;
     /// A new mesh of the domain whose element sizes follow the piecewise-constant field `sizes`
     /// on `mesh`; the generator refuses to build more than `max_elements` elements.
     fn remesh(&self, mesh: &Mesh<D>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<D>, ProblemError>;
+}
+
+/// One problem of a learning task in `D` dimensions: a domain with the expert's mesh of it.
+pub trait Problem<const D: usize>: Domain<D> {
+    /// M*, the expert's mesh the labels come from.
+    fn expert_mesh(&self) -> &Mesh<D>;
+}
+
+/// A domain with an expert's mesh of it: a [`Problem`] put together from its parts, e.g. a user's
+/// geometry and the mesh their expert made of it.
+#[derive(Clone, Debug)]
+pub struct WithExpert<P, const D: usize> {
+    pub domain: P,
+    pub expert_mesh: Mesh<D>,
+}
+
+impl<const D: usize, P: Domain<D>> Domain<D> for WithExpert<P, D> {
+    fn feature_set(&self) -> FeatureSet {
+        self.domain.feature_set()
+    }
+
+    fn optional_inputs(&self) -> &'static [&'static str] {
+        self.domain.optional_inputs()
+    }
+
+    fn initial_mesh(&self) -> &Mesh<D> {
+        self.domain.initial_mesh()
+    }
+
+    fn columns(&self, mesh: &Mesh<D>) -> Result<Vec<Column>, ProblemError> {
+        self.domain.columns(mesh)
+    }
+
+    fn remesh(&self, mesh: &Mesh<D>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<D>, ProblemError> {
+        self.domain.remesh(mesh, sizes, max_elements)
+    }
+}
+
+impl<const D: usize, P: Domain<D>> Problem<D> for WithExpert<P, D> {
+    fn expert_mesh(&self) -> &Mesh<D> {
+        &self.expert_mesh
+    }
 }
 
 /// The clip and the element budget every predicted sizing field passes before meshing (spec
@@ -129,11 +172,7 @@ pub fn with_inputs(mut features: FeatureSet, inputs: &[String]) -> FeatureSet {
 impl<const D: usize> MeshState<D> {
     /// Computes the columns of `mesh` from `problem` (plus log h(K) if `features` asks for it)
     /// and builds its graph.
-    pub fn new<P: Problem<D> + ?Sized>(
-        problem: &P,
-        features: &FeatureSet,
-        mesh: Mesh<D>,
-    ) -> Result<Self, ProblemError> {
+    pub fn new<P: Domain<D> + ?Sized>(problem: &P, features: &FeatureSet, mesh: Mesh<D>) -> Result<Self, ProblemError> {
         let mut columns = problem.columns(&mesh)?;
         if features.node.iter().any(|f| *f == NodeFeature::Column(LOG_SIZE_COLUMN.into())) {
             let values = mesh.sizes().into_iter().map(f64::ln).collect();
@@ -179,7 +218,7 @@ const BUDGET_TARGET: f64 = 0.95;
 
 /// One generation step from `mesh` with the predicted per-element `sizes`: clip below at h_min,
 /// check the element budget (skip, or scale to it, as `limits` says), mesh.
-pub fn generation_step<const D: usize, P: Problem<D> + ?Sized>(
+pub fn generation_step<const D: usize, P: Domain<D> + ?Sized>(
     problem: &P,
     mesh: &Mesh<D>,
     mut sizes: Vec<f64>,
@@ -204,5 +243,114 @@ pub fn generation_step<const D: usize, P: Problem<D> + ?Sized>(
             StepOutcome::OverBudget { estimated_elements: cap as f64 }
         }
         Err(e) => StepOutcome::Failed { reason: e.to_string() },
+    }
+}
+
+/// How far from the requested count [`mesh_to_element_count`] may land before it corrects the
+/// field and meshes again: half the ±10 % users are promised, so one correction usually suffices.
+pub const ELEMENT_COUNT_TOLERANCE: f64 = 0.05;
+
+/// Meshings [`mesh_to_element_count`] tries before it returns its closest mesh.
+const ELEMENT_COUNT_ATTEMPTS: usize = 5;
+
+/// A new mesh of `domain` whose sizes follow the shape of the field `sizes` on `mesh`, scaled by
+/// one factor so that the mesh has about `target` elements: the budget knob of `amber mesh
+/// --elements`. The first factor makes the estimate Σ|K|/V(h) equal `target`; the generator's
+/// count differs from the estimate (boundary grading, quality refinement, the 3D curvature cap), so
+/// each further attempt corrects the factor by (n/target)^(1/D) from the count n it got, until n is
+/// within [`ELEMENT_COUNT_TOLERANCE`] of `target` or [`ELEMENT_COUNT_ATTEMPTS`] meshings are spent;
+/// the mesh closest to `target` is returned. `max_elements` caps every meshing.
+pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
+    domain: &P,
+    mesh: &Mesh<D>,
+    sizes: &[f64],
+    target: usize,
+    max_elements: usize,
+) -> Result<Mesh<D>, ProblemError> {
+    if target == 0 || target > max_elements {
+        return Err(ProblemError::Meshing(MeshgenError::TooManyElements { cap: max_elements }));
+    }
+    let estimate = estimated_element_count(mesh, sizes);
+    if !estimate.is_finite() || estimate <= 0.0 {
+        let (at, value) = sizes
+            .iter()
+            .zip(mesh.midpoints())
+            .find(|(h, _)| !(h.is_finite() && **h > 0.0))
+            .map_or((Vec::new(), estimate), |(h, x)| (x.to_vec(), *h));
+        return Err(ProblemError::Meshing(MeshgenError::InvalidSize { at, value }));
+    }
+    let target_f = target as f64;
+    let mut factor = (estimate / target_f).powf(1.0 / D as f64);
+    let mut best: Option<Mesh<D>> = None;
+    for _ in 0..ELEMENT_COUNT_ATTEMPTS {
+        let scaled = sizes.iter().map(|h| h * factor).collect();
+        let candidate = domain.remesh(mesh, scaled, max_elements)?;
+        let count = candidate.num_elements() as f64;
+        let miss = |m: &Mesh<D>| (m.num_elements() as f64 / target_f - 1.0).abs();
+        let done = miss(&candidate) <= ELEMENT_COUNT_TOLERANCE;
+        if best.as_ref().is_none_or(|b| miss(&candidate) < miss(b)) {
+            best = Some(candidate);
+        }
+        if done {
+            break;
+        }
+        factor *= (count / target_f).powf(1.0 / D as f64);
+    }
+    Ok(best.expect("at least one attempt"))
+}
+
+#[cfg(test)]
+mod tests {
+    use amber_meshgen::{Mesh2dParams, MeshSizing, PolygonDomain, generate_2d, uniform_mesh_2d};
+
+    use super::*;
+
+    /// The unit square with a hole, no inputs.
+    struct Holed {
+        domain: PolygonDomain,
+        initial_mesh: Mesh<2>,
+    }
+
+    impl Domain<2> for Holed {
+        fn feature_set(&self) -> FeatureSet {
+            FeatureSet::console()
+        }
+
+        fn initial_mesh(&self) -> &Mesh<2> {
+            &self.initial_mesh
+        }
+
+        fn columns(&self, _: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
+            Ok(Vec::new())
+        }
+
+        fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
+            let params = Mesh2dParams::default().with_max_elements(max_elements);
+            Ok(generate_2d(&self.domain, &MeshSizing::new(mesh, sizes), &params)?)
+        }
+    }
+
+    /// A field graded by a factor of 20 towards one corner, asked for 0.25×, 1× and 4× its own
+    /// count: every mesh lands within the tolerance, keeps the grading, and covers the domain.
+    #[test]
+    fn meshes_reach_the_requested_element_count() {
+        let hole = vec![[0.4, 0.4], [0.4, 0.6], [0.6, 0.6], [0.6, 0.4]];
+        let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![hole]).unwrap();
+        let initial_mesh = uniform_mesh_2d(&domain, 0.1, &Mesh2dParams::default()).unwrap();
+        let holed = Holed { domain, initial_mesh };
+        let mesh = holed.initial_mesh();
+        let sizes: Vec<f64> = mesh.midpoints().iter().map(|x| 0.004 + 0.08 * (x[0] + x[1]) / 2.0).collect();
+        let natural = holed.remesh(mesh, sizes.clone(), 1_000_000).unwrap().num_elements();
+        for target in [natural / 4, natural, 4 * natural] {
+            let made = mesh_to_element_count(&holed, mesh, &sizes, target, 1_000_000).unwrap();
+            let ratio = made.num_elements() as f64 / target as f64;
+            assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements for {target}", made.num_elements());
+            assert!((made.total_volume() - 0.96).abs() < 1e-12);
+            let near = made.midpoints().iter().filter(|x| x[0] + x[1] < 1.0).count();
+            assert!(near > made.num_elements() / 2, "the grading is kept: {near} of {}", made.num_elements());
+        }
+        assert!(mesh_to_element_count(&holed, mesh, &sizes, 10, 5).is_err());
+        let broken: Vec<f64> = sizes.iter().map(|_| f64::NAN).collect();
+        assert!(mesh_to_element_count(&holed, mesh, &broken, 100, 1_000).is_err());
     }
 }

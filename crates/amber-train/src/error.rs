@@ -34,6 +34,10 @@ pub enum TrainError {
     /// A file is not valid JSON of the expected shape.
     #[error("{path}: {source}")]
     Json { path: PathBuf, source: serde_json::Error },
+    /// A generation step of [`crate::generate`] produced no mesh (over the budget, or the
+    /// generator failed); `step` counts from 1.
+    #[error("generation step {step}: {reason}")]
+    Generation { step: usize, reason: String },
     /// A checkpoint is missing a piece or does not fit the run it should resume.
     #[error("checkpoint {path}: {message}")]
     Checkpoint { path: PathBuf, message: String },

@@ -37,6 +37,6 @@ pub use config::{DataConfig, LrSchedule, Profile};
 pub use error::{Result, TrainError};
 pub use method::{MethodConfig, TrainedModel};
 pub use rollout::{
-    Evaluation, EvaluationSummary, MeshMetrics, PredictedField, Reference, Rollout, RolloutStep, SizingModel,
-    StepStatus, StepSummary, rollouts,
+    ElementTarget, Evaluation, EvaluationSummary, GeneratedStep, MeshMetrics, PredictedField, Reference, Rollout,
+    RolloutStep, SizingModel, StepStatus, StepSummary, generate, rollouts,
 };

@@ -4,10 +4,11 @@
 
 use std::path::Path;
 
-use amber_tasks::{MeshLimits, Problem};
+use amber_tasks::{Domain, MeshLimits, Problem};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError};
+use crate::rollout::{ElementTarget, GeneratedStep, generate};
 use crate::{
     AmberModel, CNN_PREDICTOR_FILE, CnnConfig, CnnModel, CnnObserver, CnnTraining, DataConfig, Evaluation, MODEL_DIR,
     Rollout, Training, TrainingConfig, TrainingObserver,
@@ -144,6 +145,20 @@ impl TrainedModel {
         match self {
             TrainedModel::Amber(m) => Ok(evaluation.run(&m.sizing(), steps)?.0),
             TrainedModel::Cnn(m) => Ok(evaluation.run(&m.sizing(), steps)?.0),
+        }
+    }
+
+    /// Meshes `domain` (no expert needed): `steps` generation steps from its M⁰, the last one
+    /// aimed at `target` elements when given (see [`generate`]).
+    pub fn generate<const D: usize, P: Domain<D>>(
+        &self,
+        domain: &P,
+        steps: usize,
+        target: Option<ElementTarget>,
+    ) -> Result<Vec<GeneratedStep<D>>> {
+        match self {
+            TrainedModel::Amber(m) => generate(&m.sizing(), domain, steps, target),
+            TrainedModel::Cnn(m) => generate(&m.sizing(), domain, steps, target),
         }
     }
 

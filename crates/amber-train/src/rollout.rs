@@ -1,7 +1,8 @@
 //! Inference for both methods (spec §6, reference notes §6.5): T generation steps from M⁰
 //! (predict → clip at h_min → budget guard → generate), every intermediate mesh compared with
 //! the expert in the same parallel pass, normalised by the initial mesh M⁰ and the reconstruction
-//! M̂ (spec §7). A method plugs in through [`SizingModel`].
+//! M̂ (spec §7). A method plugs in through [`SizingModel`]. [`generate`] is the same loop on a
+//! domain without an expert: what `amber mesh --model` runs.
 
 use amber_mesh::Mesh;
 use amber_metrics::{compare_meshes, normalised_dcd};
@@ -9,7 +10,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, in_problem};
-use amber_tasks::{MeshLimits, Problem, ProblemError, StepOutcome, generation_step};
+use amber_tasks::{Domain, MeshLimits, Problem, ProblemError, StepOutcome, generation_step, mesh_to_element_count};
 
 /// The per-problem constants of the normalised DCD: the reconstruction M̂ (the generator run
 /// with the expert's own sizing field, clipped at h_min) and the DCDs of M⁰ and M̂ to M*.
@@ -120,7 +121,7 @@ pub trait SizingModel: Sync {
     fn limits(&self) -> &MeshLimits;
 
     /// The field of each `(problem, current mesh)` pair, in order.
-    fn predict<const D: usize, P: Problem<D>>(
+    fn predict<const D: usize, P: Domain<D>>(
         &self,
         problems: &[&P],
         meshes: &[&Mesh<D>],
@@ -196,6 +197,63 @@ pub fn rollouts<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
             active[i] &= step.status == StepStatus::Meshed;
             out[i].steps.push(step);
         }
+    }
+    Ok(out)
+}
+
+/// One step of [`generate`]: the field predicted on the previous mesh (per element of it, or of
+/// the method's own auxiliary mesh) and the mesh made from it.
+pub struct GeneratedStep<const D: usize> {
+    pub field: PredictedField<D>,
+    pub mesh: Mesh<D>,
+}
+
+/// An element count to aim the last step of [`generate`] at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ElementTarget {
+    /// Elements wanted (reached within `amber_tasks::ELEMENT_COUNT_TOLERANCE` when the
+    /// generator allows).
+    pub elements: usize,
+    /// The generator refuses to build more than this.
+    pub max_elements: usize,
+}
+
+/// Meshes `domain` with `model` for `steps` generation steps from its M⁰ (predict, clip at
+/// h_min, budget guard, mesh), as a rollout does but without an expert to compare with. With a
+/// `target`, the last step's field keeps its shape and is scaled to the target's element count
+/// (instead of the budget guard): the model decides where elements go, the user how many. A
+/// step that makes no mesh is an error naming the step.
+pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
+    model: &M,
+    domain: &P,
+    steps: usize,
+    target: Option<ElementTarget>,
+) -> Result<Vec<GeneratedStep<D>>> {
+    let mut out: Vec<GeneratedStep<D>> = Vec::with_capacity(steps);
+    for step in 1..=steps {
+        let current = out.last().map_or(domain.initial_mesh(), |s| &s.mesh);
+        let field = model.predict(&[domain], &[current])?.pop().expect("one field per domain");
+        let on = field.mesh.as_ref().unwrap_or(current);
+        let mesh = match target.filter(|_| step == steps) {
+            Some(target) => {
+                let min_size = model.limits().min_size;
+                let sizes: Vec<f64> = field.sizes.iter().map(|h| h.max(min_size)).collect();
+                mesh_to_element_count(domain, on, &sizes, target.elements, target.max_elements)
+                    .map_err(|e| TrainError::Generation { step, reason: e.to_string() })?
+            }
+            None => match generation_step(domain, on, field.sizes.clone(), model.limits()) {
+                StepOutcome::Meshed(mesh) => mesh,
+                StepOutcome::OverBudget { estimated_elements } => {
+                    let reason = format!(
+                        "the predicted field asks for about {estimated_elements:.0} elements, over the model's budget of {}",
+                        model.limits().max_elements
+                    );
+                    return Err(TrainError::Generation { step, reason });
+                }
+                StepOutcome::Failed { reason } => return Err(TrainError::Generation { step, reason }),
+            },
+        };
+        out.push(GeneratedStep { field, mesh });
     }
     Ok(out)
 }

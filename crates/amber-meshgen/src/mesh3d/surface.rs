@@ -12,7 +12,8 @@ use std::collections::{HashMap, VecDeque};
 use std::path::{Path, PathBuf};
 
 pub use amber_mesh::StlFaceIds;
-use amber_mesh::{MeshError, read_surface};
+use amber_mesh::{FacetAdjacency, Mesh3, MeshError, read_surface};
+use nalgebra::Vector3;
 
 use super::intersect::intersecting_pairs;
 use super::predicates::orient2d;
@@ -180,6 +181,76 @@ impl Surface {
         let mut surface = Self::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(defect)?;
         let report = surface.validate().map_err(defect)?;
         Ok((surface, report))
+    }
+
+    /// The boundary surface of a tet mesh: its boundary triangles, oriented outwards, over its
+    /// boundary vertices, all in face 1 (see [`Surface::split_faces_at_feature_edges`]); not yet
+    /// validated. A mesh whose facets do not pair up (three tets on one triangle) is an error.
+    pub fn from_mesh_boundary(mesh: &Mesh3) -> Result<Self, SurfaceError> {
+        let facets = FacetAdjacency::new(mesh)?.oriented_boundary_facets(mesh);
+        let mut index = vec![u32::MAX; mesh.num_vertices()];
+        let mut vertices = Vec::new();
+        let triangles: Vec<[u32; 3]> = facets
+            .iter()
+            .map(|facet| {
+                facet.map(|v| {
+                    if index[v as usize] == u32::MAX {
+                        index[v as usize] = vertices.len() as u32;
+                        vertices.push(mesh.vertices()[v as usize]);
+                    }
+                    index[v as usize]
+                })
+            })
+            .collect();
+        let face_ids = vec![1; triangles.len()];
+        Self::new(vertices, triangles, face_ids).map_err(|source| SurfaceError::Defect { path: PathBuf::new(), source })
+    }
+
+    /// Splits the faces at feature edges, for surfaces whose files carry no CAD faces: two
+    /// triangles across an edge stay in one face when they were in one face and their normals
+    /// differ by at most `angle_degrees`. Faces are renumbered from 1 in the order of their first
+    /// triangle. The surface must be validated again.
+    pub fn split_faces_at_feature_edges(&mut self, angle_degrees: f64) {
+        let normal = |t: &[u32; 3]| {
+            let p = |k: usize| Vector3::from(self.vertices[t[k] as usize]);
+            (p(1) - p(0)).cross(&(p(2) - p(0))).normalize()
+        };
+        let normals: Vec<Vector3<f64>> = self.triangles.iter().map(normal).collect();
+        let cos_limit = angle_degrees.to_radians().cos();
+        let mut by_edge: HashMap<[u32; 2], Vec<usize>> = HashMap::with_capacity(3 * self.triangles.len() / 2);
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                by_edge.entry([a.min(b), a.max(b)]).or_default().push(t);
+            }
+        }
+        let mut face = vec![0i32; self.triangles.len()];
+        let mut next_id = 0;
+        let mut queue = VecDeque::new();
+        for seed in 0..self.triangles.len() {
+            if face[seed] != 0 {
+                continue;
+            }
+            next_id += 1;
+            face[seed] = next_id;
+            queue.push_back(seed);
+            while let Some(t) = queue.pop_front() {
+                let tri = self.triangles[t];
+                for k in 0..3 {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    for &u in &by_edge[&[a.min(b), a.max(b)]] {
+                        // A NaN normal (a sliver) compares false and stays out of the face.
+                        let smooth = normals[t].dot(&normals[u]) >= cos_limit;
+                        if face[u] == 0 && self.face_ids[u] == self.face_ids[t] && smooth {
+                            face[u] = next_id;
+                            queue.push_back(u);
+                        }
+                    }
+                }
+            }
+        }
+        self.face_ids = face;
+        self.valid = false;
     }
 
     /// Whether [`Surface::validate`] has succeeded on this surface.
@@ -473,6 +544,33 @@ mod tests {
         assert_eq!(report.flipped_triangles, 2);
         assert_eq!((report.euler_characteristic, report.genus()), (2, 0));
         assert!((report.enclosed_volume - 1.0).abs() < 1e-15);
+    }
+
+    /// A cube's surface with one face id gets its six sides back from the feature edges (90°),
+    /// and none at an angle above 90°; a tet mesh of the cube gives back a closed surface of the
+    /// cube's volume with the same six faces.
+    #[test]
+    fn feature_edges_split_faces_and_mesh_boundaries_bound_the_mesh() {
+        let mut s = cube();
+        s.face_ids.iter_mut().for_each(|id| *id = 7);
+        s.split_faces_at_feature_edges(30.0);
+        let mut ids = s.face_ids().to_vec();
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids, [1, 2, 3, 4, 5, 6]);
+        assert!(s.triangles().chunks(2).zip(s.face_ids().chunks(2)).all(|(_, f)| f[0] == f[1]));
+        s.split_faces_at_feature_edges(95.0);
+        assert!(s.face_ids().iter().all(|&id| id == 1));
+
+        let mut cube = cube();
+        cube.validate().unwrap();
+        let mesh = crate::mesh3d::generate_3d(&cube, &crate::ConstantSize(0.3), &Default::default()).unwrap();
+        let mut boundary = Surface::from_mesh_boundary(&mesh).unwrap();
+        boundary.split_faces_at_feature_edges(30.0);
+        assert_eq!(*boundary.face_ids().iter().max().unwrap(), 6);
+        let report = boundary.validate().unwrap();
+        assert_eq!(report.flipped_triangles, 0, "mesh boundaries come out oriented");
+        assert!((report.enclosed_volume - mesh.total_volume()).abs() < 1e-12);
     }
 
     #[test]

@@ -18,10 +18,11 @@ mod problem;
 use std::path::{Path, PathBuf};
 
 use amber_mesh::{Mesh3, MeshError, read_mesh};
-use amber_meshgen::ConstantSize;
-use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, StlFaceIds, Surface, SurfaceError, generate_3d};
+use amber_meshgen::mesh3d::{Mesh3dError, StlFaceIds, Surface, SurfaceError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+
+use crate::part::SolidPart;
 
 /// Element volume of M⁰ in mm³ (spec §9).
 pub const INITIAL_ELEMENT_VOLUME: f64 = 10.0;
@@ -37,11 +38,6 @@ pub const INITIAL_SIZE: f64 = 4.3955;
 /// more tets, which moved d(M⁰, M*), the anchor of the normalised DCD, from the reference's
 /// 0.75–0.85 to 0.70.
 pub const INITIAL_MESH_RECIPE: &str = "uniform h0 = 4.3955 mm, no curvature cap, size factor 1";
-
-/// The 3D generator's settings for M⁰ (see [`INITIAL_MESH_RECIPE`]).
-fn initial_mesh_params() -> Mesh3dParams {
-    Mesh3dParams { curvature_tolerance: f64::INFINITY, size_factor: 1.0, ..Mesh3dParams::default() }
-}
 
 /// Where the data comes from and how to make the reference surfaces, for error messages.
 const HOW_TO_GET_THE_DATA: &str = "download the Console data (MIT licence) of the AMBER authors' repository, \
@@ -111,17 +107,14 @@ pub enum ConsoleError {
     InitialMesh { name: String, source: Mesh3dError },
 }
 
-/// One Console part.
+/// One Console part with its expert's mesh.
 #[derive(Clone, Debug)]
 pub struct ConsoleProblem {
-    /// `split/NNN`, e.g. `train/001`.
-    pub name: String,
-    /// M⁰: the uniform mesh with h₀ = [`INITIAL_SIZE`].
-    pub initial_mesh: Mesh3,
+    /// The part, named `split/NNN` (e.g. `train/001`): the validated reference surface (mm, CAD
+    /// face ids) and M⁰, the uniform mesh with h₀ = [`INITIAL_SIZE`].
+    pub part: SolidPart,
     /// M*: the expert's mesh (mm).
     pub expert_mesh: Mesh3,
-    /// The validated reference surface (mm, CAD face ids) every new mesh is made from.
-    pub reference: Surface,
 }
 
 impl ConsoleProblem {
@@ -135,9 +128,9 @@ impl ConsoleProblem {
         }
         let expert_mesh = read_mesh::<3>(&nas)?;
         let (reference, _) = Surface::load(&stl, StlFaceIds::FromFile)?;
-        let initial_mesh = generate_3d(&reference, &ConstantSize(INITIAL_SIZE), &initial_mesh_params())
-            .map_err(|source| ConsoleError::InitialMesh { name: name.clone(), source })?;
-        Ok(Self { name, initial_mesh, expert_mesh, reference })
+        let part = SolidPart::new(name.clone(), reference, INITIAL_SIZE)
+            .map_err(|source| ConsoleError::InitialMesh { name, source })?;
+        Ok(Self { part, expert_mesh })
     }
 }
 
@@ -221,21 +214,21 @@ mod tests {
         let Some(data) = amber_testdata::shared("data/console") else { return };
         let start = std::time::Instant::now();
         let problem = ConsoleProblem::load(&data, ConsoleSplit::Val, "002").unwrap();
-        let (m0, expert) = (&problem.initial_mesh, &problem.expert_mesh);
+        let (m0, expert) = (&problem.part.initial_mesh, &problem.expert_mesh);
         println!(
             "{}: expert {} tets, M⁰ {} tets, {:.2} s",
-            problem.name,
+            problem.part.name,
             expert.num_elements(),
             m0.num_elements(),
             start.elapsed().as_secs_f64()
         );
-        assert_eq!(problem.name, "val/002");
+        assert_eq!(problem.part.name, "val/002");
         assert_eq!(expert.num_elements(), 17489);
         // M⁰ fills the same solid, with elements far coarser than the expert's.
-        let volume = problem.reference.enclosed_volume();
+        let volume = problem.part.surface.enclosed_volume();
         assert!((m0.total_volume() / volume - 1.0).abs() < 5e-3 && (expert.total_volume() / volume - 1.0).abs() < 5e-3);
         assert!((500..6_000).contains(&m0.num_elements()), "{} tets", m0.num_elements());
-        assert!(problem.reference.is_validated());
+        assert!(problem.part.surface.is_validated());
     }
 
     #[test]

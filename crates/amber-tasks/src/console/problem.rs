@@ -1,38 +1,35 @@
-//! The Console task (spec §9) as a [`Problem<3>`]: geometric features only (node [volume], edge
-//! [3D midpoint difference]), labels from the expert's tet mesh, and every new mesh made by the
-//! 3D generator from the part's reference surface and the piecewise-constant field on the
-//! current mesh.
+//! The Console task (spec §9) as a [`Problem<3>`]: a [`SolidPart`](crate::part::SolidPart)
+//! (geometric features only, every new mesh made by the 3D generator from the part's reference
+//! surface and the piecewise-constant field on the current mesh) with labels from the expert's
+//! tet mesh.
 
 use amber_graph::FeatureSet;
 use amber_mesh::Mesh;
-use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
-use amber_meshgen::{MeshSizing, MeshgenError};
 
 use super::ConsoleProblem;
-use crate::problem::{Column, Problem, ProblemError};
+use crate::problem::{Column, Domain, Problem, ProblemError};
 
-impl Problem<3> for ConsoleProblem {
+impl Domain<3> for ConsoleProblem {
     fn feature_set(&self) -> FeatureSet {
-        FeatureSet::console()
+        self.part.feature_set()
     }
 
     fn initial_mesh(&self) -> &Mesh<3> {
-        &self.initial_mesh
+        &self.part.initial_mesh
     }
 
-    fn expert_mesh(&self) -> &Mesh<3> {
-        &self.expert_mesh
-    }
-
-    /// None: the Console features are geometric, computed by the graph.
-    fn columns(&self, _mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
-        Ok(Vec::new())
+    fn columns(&self, mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
+        self.part.columns(mesh)
     }
 
     fn remesh(&self, mesh: &Mesh<3>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<3>, ProblemError> {
-        let params = Mesh3dParams::default().with_max_elements(max_elements);
-        generate_3d(&self.reference, &MeshSizing::new(mesh, sizes), &params)
-            .map_err(|e| ProblemError::Meshing(MeshgenError::from(e)))
+        self.part.remesh(mesh, sizes, max_elements)
+    }
+}
+
+impl Problem<3> for ConsoleProblem {
+    fn expert_mesh(&self) -> &Mesh<3> {
+        &self.expert_mesh
     }
 }
 
@@ -57,11 +54,11 @@ mod tests {
         let StepOutcome::Meshed(mesh) = generation_step(&problem, m0, vec![3.0; m0.num_elements()], &limits) else {
             panic!("the 3 mm step was not meshed")
         };
-        let volume = problem.reference.enclosed_volume();
+        let volume = problem.part.surface.enclosed_volume();
         let expected = volume / amber_mesh::volume_from_size::<3>(3.0);
         println!(
             "{}: M⁰ {} tets -> {} tets with 3 mm (≈{expected:.0} regular tets) in {:.2} s",
-            problem.name,
+            problem.part.name,
             m0.num_elements(),
             mesh.num_elements(),
             start.elapsed().as_secs_f64()

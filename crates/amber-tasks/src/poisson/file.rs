@@ -1,6 +1,7 @@
 //! The JSON file of one Poisson problem. The layout is the reference implementation's —
 //! `domain.polygon`, `load.{means, covariances, weights}`, `initial_mesh` and `mesh` with
-//! `vertices` and `triangles` — plus our `metadata`, so one reader serves both.
+//! `vertices` and `triangles` — plus our `metadata`, so one reader serves both. The same layout
+//! without the meshes (and with any polygon, holes allowed) describes a [`PoissonPart`].
 
 use std::path::{Path, PathBuf};
 
@@ -8,7 +9,7 @@ use amber_fem::GaussianMixture;
 use amber_mesh::Mesh2;
 use serde::{Deserialize, Serialize};
 
-use super::{PoissonProblem, ProblemMetadata, lshape_polygon};
+use super::{PoissonPart, PoissonProblem, ProblemMetadata, lshape_polygon};
 use crate::TaskError;
 
 #[derive(Serialize, Deserialize)]
@@ -24,6 +25,19 @@ struct ProblemFile {
 #[derive(Serialize, Deserialize)]
 struct DomainFile {
     polygon: Vec<[f64; 2]>,
+    /// Holes of a part's domain (problems are L-shapes without holes).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    holes: Vec<Vec<[f64; 2]>>,
+}
+
+/// A problem file read as a part: the expert mesh is ignored and M⁰ optional.
+#[derive(Deserialize)]
+struct PartFile {
+    domain: DomainFile,
+    load: GaussianMixture,
+    initial_mesh: Option<MeshFile>,
+    #[serde(default)]
+    metadata: ProblemMetadata,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -52,7 +66,7 @@ impl PoissonProblem {
     /// The problem as JSON bytes (deterministic: the same problem gives the same bytes).
     pub fn to_json(&self) -> Vec<u8> {
         let file = ProblemFile {
-            domain: DomainFile { polygon: self.polygon().to_vec() },
+            domain: DomainFile { polygon: self.polygon().to_vec(), holes: Vec::new() },
             load: self.load.clone(),
             initial_mesh: MeshFile::from_mesh(&self.initial_mesh),
             mesh: MeshFile::from_mesh(&self.expert_mesh),
@@ -86,6 +100,22 @@ impl PoissonProblem {
 pub fn read_problem(path: &Path) -> Result<PoissonProblem, TaskError> {
     let bytes = std::fs::read(path).map_err(|source| TaskError::Io { path: path.into(), source })?;
     PoissonProblem::from_json(&bytes, path)
+}
+
+/// Reads a problem file (ours or the reference's) as a [`PoissonPart`]: its domain (any polygon,
+/// with optional `domain.holes`), load and, when present, initial mesh; an expert `mesh` is not
+/// needed and not read.
+pub fn read_part(path: &Path) -> Result<PoissonPart, TaskError> {
+    let bytes = std::fs::read(path).map_err(|source| TaskError::Io { path: path.into(), source })?;
+    let file: PartFile =
+        serde_json::from_slice(&bytes).map_err(|source| TaskError::Json { path: path.into(), source })?;
+    let domain = amber_meshgen::PolygonDomain::new(file.domain.polygon, file.domain.holes)
+        .map_err(|e| TaskError::Polygon { path: path.into(), message: e.to_string() })?;
+    let initial_mesh = file.initial_mesh.map(|m| m.into_mesh(path, "initial_mesh")).transpose()?;
+    let order =
+        file.metadata.heuristic.map_or(amber_fem::ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order);
+    PoissonPart::new(domain, file.load, initial_mesh, order)
+        .map_err(|e| TaskError::Polygon { path: path.into(), message: format!("initial mesh: {e}") })
 }
 
 /// Reads every problem file (`*.json`, ours or the reference's format) of a directory in name

@@ -7,8 +7,8 @@ mod problem;
 pub use dataset::{
     DatasetManifest, Split, SplitReport, SplitRequest, load_split, problem_seeds, split_dir, write_split,
 };
-pub use file::{read_problem, read_split};
-pub use problem::{LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN};
+pub use file::{read_part, read_problem, read_split};
+pub use problem::{LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, PoissonPart};
 
 use std::fmt;
 use std::str::FromStr;

@@ -1,13 +1,15 @@
 //! The Poisson task as a [`Problem<2>`]: each mesh's columns come from the P1 solution of
-//! −Δu = f on it, and every new mesh is made by the 2D generator on the problem's L-shape.
+//! −Δu = f on it, and every new mesh is made by the 2D generator on the problem's L-shape. A
+//! [`PoissonPart`] is the same task on any polygon with holes and without an expert: what a
+//! trained Poisson model meshes.
 
-use amber_fem::{ExpertHeuristic, Load, P1Space, Quadrature, element_stats};
+use amber_fem::{ExpertHeuristic, GaussianMixture, Load, P1Space, Quadrature, element_stats};
 use amber_graph::FeatureSet;
-use amber_mesh::Mesh;
-use amber_meshgen::{Mesh2dParams, MeshSizing, PolygonDomain, generate_2d};
+use amber_mesh::{Mesh, Mesh2};
+use amber_meshgen::{Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, generate_2d, uniform_mesh_2d};
 
-use super::PoissonProblem;
-use crate::problem::{Column, Problem, ProblemError};
+use super::{INITIAL_SIZE, PoissonProblem};
+use crate::problem::{Column, Domain, Problem, ProblemError};
 
 /// Name of the optional input ln η_K: the residual error indicator of the current solution, the
 /// quantity the expert's refinement loop marks by. An adaptive solver computes it anyway; the
@@ -19,55 +21,126 @@ pub const LOG_ERROR_INDICATOR_COLUMN: &str = "log_error_indicator";
 /// yet the expert refines well into the flanks. Not in the paper.
 pub const LOG_LOAD_COLUMN: &str = "log_load";
 
-impl Problem<2> for PoissonProblem {
+/// The optional inputs of the Poisson task.
+const OPTIONAL_INPUTS: &[&str] = &[LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN];
+
+impl PoissonProblem {
+    /// The quadrature order of the expert's solver (the default heuristic's when unknown).
+    fn quadrature_order(&self) -> usize {
+        self.metadata.heuristic.as_ref().map_or(ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order)
+    }
+}
+
+impl Domain<2> for PoissonProblem {
     fn feature_set(&self) -> FeatureSet {
         FeatureSet::poisson()
     }
 
     fn optional_inputs(&self) -> &'static [&'static str] {
-        &[LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN]
+        OPTIONAL_INPUTS
     }
 
     fn initial_mesh(&self) -> &Mesh<2> {
         &self.initial_mesh
     }
 
-    fn expert_mesh(&self) -> &Mesh<2> {
-        &self.expert_mesh
-    }
-
-    /// Solves −Δu = f (P1) on `mesh`: `solution_mean`, `solution_std` of u over each element's
-    /// vertices, `load` = f at the element midpoint, and the optional inputs ln η_K and the
-    /// log-scaled load.
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-        let order = self
-            .metadata
-            .heuristic
-            .as_ref()
-            .map_or(ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order);
-        let space = P1Space::new(mesh)?;
-        let quadrature = Quadrature::simplex::<2>(order)?;
-        let samples = space.sample_load(&self.load, &quadrature)?;
-        let solution = space.solve_poisson(&samples)?;
-        let stats = element_stats(mesh, &solution.u)?;
-        let indicator = space.residual_estimator(&solution.u, &samples)?;
-        let load: Vec<f64> = mesh.midpoints().into_iter().map(|x| Load::value(&self.load, x)).collect();
-        let log_load = load.iter().map(|f| f.signum() * f.abs().ln_1p()).collect();
-        Ok(vec![
-            Column { name: "solution_mean".into(), values: stats.iter().map(|s| s.mean).collect() },
-            Column { name: "solution_std".into(), values: stats.iter().map(|s| s.std).collect() },
-            Column { name: "load".into(), values: load },
-            Column {
-                name: LOG_ERROR_INDICATOR_COLUMN.into(),
-                values: indicator.iter().map(|eta| eta.max(f64::MIN_POSITIVE).ln()).collect(),
-            },
-            Column { name: LOG_LOAD_COLUMN.into(), values: log_load },
-        ])
+        poisson_columns(&self.load, self.quadrature_order(), mesh)
     }
 
     fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
-        let domain = PolygonDomain::lshape(self.corner)?;
-        let params = Mesh2dParams::default().with_max_elements(max_elements);
-        Ok(generate_2d(&domain, &MeshSizing::new(mesh, sizes), &params)?)
+        remesh_polygon(&PolygonDomain::lshape(self.corner)?, mesh, sizes, max_elements)
     }
+}
+
+impl Problem<2> for PoissonProblem {
+    fn expert_mesh(&self) -> &Mesh<2> {
+        &self.expert_mesh
+    }
+}
+
+/// The Poisson task on any polygon with holes, without an expert: −Δu = f with u = 0 on the
+/// whole boundary, the inputs a trained Poisson model reads, and M⁰.
+#[derive(Clone, Debug)]
+pub struct PoissonPart {
+    pub domain: PolygonDomain,
+    pub load: GaussianMixture,
+    /// Quadrature order of the load integrals (the expert heuristic's).
+    pub quadrature_order: usize,
+    /// M⁰: the given initial mesh, or a uniform mesh of size [`INITIAL_SIZE`].
+    pub initial_mesh: Mesh2,
+}
+
+impl PoissonPart {
+    /// A part on `domain` with load `load`, starting from `initial_mesh` or, when `None`, from a
+    /// uniform mesh of size [`INITIAL_SIZE`] (how generated problems make M⁰).
+    pub fn new(
+        domain: PolygonDomain,
+        load: GaussianMixture,
+        initial_mesh: Option<Mesh2>,
+        quadrature_order: usize,
+    ) -> Result<Self, MeshgenError> {
+        let initial_mesh = match initial_mesh {
+            Some(mesh) => mesh,
+            None => uniform_mesh_2d(&domain, INITIAL_SIZE, &Mesh2dParams::default())?,
+        };
+        Ok(Self { domain, load, quadrature_order, initial_mesh })
+    }
+}
+
+impl Domain<2> for PoissonPart {
+    fn feature_set(&self) -> FeatureSet {
+        FeatureSet::poisson()
+    }
+
+    fn optional_inputs(&self) -> &'static [&'static str] {
+        OPTIONAL_INPUTS
+    }
+
+    fn initial_mesh(&self) -> &Mesh<2> {
+        &self.initial_mesh
+    }
+
+    fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
+        poisson_columns(&self.load, self.quadrature_order, mesh)
+    }
+
+    fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
+        remesh_polygon(&self.domain, mesh, sizes, max_elements)
+    }
+}
+
+/// Solves −Δu = f (P1) on `mesh`: `solution_mean`, `solution_std` of u over each element's
+/// vertices, `load` = f at the element midpoint, and the optional inputs ln η_K and the
+/// log-scaled load.
+fn poisson_columns(load: &GaussianMixture, quadrature_order: usize, mesh: &Mesh2) -> Result<Vec<Column>, ProblemError> {
+    let space = P1Space::new(mesh)?;
+    let quadrature = Quadrature::simplex::<2>(quadrature_order)?;
+    let samples = space.sample_load(load, &quadrature)?;
+    let solution = space.solve_poisson(&samples)?;
+    let stats = element_stats(mesh, &solution.u)?;
+    let indicator = space.residual_estimator(&solution.u, &samples)?;
+    let values: Vec<f64> = mesh.midpoints().into_iter().map(|x| Load::value(load, x)).collect();
+    let log_load = values.iter().map(|f| f.signum() * f.abs().ln_1p()).collect();
+    Ok(vec![
+        Column { name: "solution_mean".into(), values: stats.iter().map(|s| s.mean).collect() },
+        Column { name: "solution_std".into(), values: stats.iter().map(|s| s.std).collect() },
+        Column { name: "load".into(), values },
+        Column {
+            name: LOG_ERROR_INDICATOR_COLUMN.into(),
+            values: indicator.iter().map(|eta| eta.max(f64::MIN_POSITIVE).ln()).collect(),
+        },
+        Column { name: LOG_LOAD_COLUMN.into(), values: log_load },
+    ])
+}
+
+/// A new mesh of `domain` from the piecewise-constant field `sizes` on `mesh`.
+fn remesh_polygon(
+    domain: &PolygonDomain,
+    mesh: &Mesh2,
+    sizes: Vec<f64>,
+    max_elements: usize,
+) -> Result<Mesh2, ProblemError> {
+    let params = Mesh2dParams::default().with_max_elements(max_elements);
+    Ok(generate_2d(domain, &MeshSizing::new(mesh, sizes), &params)?)
 }

@@ -9,7 +9,7 @@ use amber_stdx::{read_json, write_json_atomic};
 use serde::{Deserialize, Serialize};
 
 use amber_mesh::Mesh;
-use amber_tasks::{MeshLimits, MeshState, Problem};
+use amber_tasks::{Domain, MeshLimits, MeshState};
 use rayon::prelude::*;
 
 use crate::error::{Result, in_problem, io_error};
@@ -67,7 +67,7 @@ impl SizingModel for AmberSizing<'_> {
         &self.predictor.limits
     }
 
-    fn predict<const D: usize, P: Problem<D>>(
+    fn predict<const D: usize, P: Domain<D>>(
         &self,
         problems: &[&P],
         meshes: &[&Mesh<D>],

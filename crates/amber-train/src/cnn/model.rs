@@ -8,7 +8,7 @@ use amber_graph::{GraphError, NodeFeature, RunningMoments, VARIANCE_EPSILON};
 use amber_mesh::Mesh;
 use amber_meshgen::SizingField;
 use amber_stdx::{read_json, write_json_atomic};
-use amber_tasks::{MeshLimits, Problem};
+use amber_tasks::{Domain, MeshLimits};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -52,7 +52,7 @@ fn auxiliary_size<const D: usize>(grid: &PixelGrid<D>) -> f64 {
 
 /// Meshes the auxiliary mesh of `problem` for a grid of `resolution` pixels per axis over its
 /// geometry's bounding box, computes its columns and rasterises them.
-pub(super) fn rasterise<const D: usize, P: Problem<D> + ?Sized>(
+pub(super) fn rasterise<const D: usize, P: Domain<D> + ?Sized>(
     problem: &P,
     index: usize,
     resolution: usize,
@@ -173,7 +173,7 @@ impl SizingModel for CnnSizing<'_> {
         &self.predictor.limits
     }
 
-    fn predict<const D: usize, P: Problem<D>>(
+    fn predict<const D: usize, P: Domain<D>>(
         &self,
         problems: &[&P],
         _meshes: &[&Mesh<D>],

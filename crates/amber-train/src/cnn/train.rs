@@ -292,7 +292,7 @@ mod tests {
     use amber_mesh::Mesh3;
     use amber_tasks::poisson::{INITIAL_SIZE, PoissonProblem};
 
-    use amber_tasks::{Column, ProblemError};
+    use amber_tasks::{Column, Domain, ProblemError};
 
     /// Poisson problems with small experts (8 refinement steps).
     fn poisson(seeds: &[u64]) -> Vec<PoissonProblem> {
@@ -396,16 +396,18 @@ mod tests {
     }
 
     impl Problem<3> for CubeProblem {
+        fn expert_mesh(&self) -> &Mesh3 {
+            &self.expert
+        }
+    }
+
+    impl Domain<3> for CubeProblem {
         fn feature_set(&self) -> FeatureSet {
             FeatureSet::console()
         }
 
         fn initial_mesh(&self) -> &Mesh3 {
             &self.initial
-        }
-
-        fn expert_mesh(&self) -> &Mesh3 {
-            &self.expert
         }
 
         fn columns(&self, _: &Mesh3) -> Result<Vec<Column>, ProblemError> {

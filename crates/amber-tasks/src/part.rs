@@ -1,0 +1,103 @@
+//! Geometry-only domains: a solid bounded by a validated, CAD-face-labelled surface, with no
+//! task inputs beyond the geometry of its meshes. A geometry-only model (Console's) meshes any
+//! [`SolidPart`]; every Console problem is one with its expert's mesh.
+
+use std::path::Path;
+
+use amber_graph::FeatureSet;
+use amber_mesh::{Mesh, Mesh3, StlFaceIds, read_mesh, read_surface};
+use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, Surface, generate_3d};
+use amber_meshgen::{ConstantSize, MeshSizing, MeshgenError, PolygonDomain};
+
+use crate::TaskError;
+use crate::problem::{Column, Domain, ProblemError};
+
+/// The dihedral angle above which an edge of a surface without CAD faces separates two faces:
+/// sheet-metal bends and flanges meet at 90°, and a faceted curved face turns by far less per
+/// edge at the resolutions a part is exported with.
+pub const FEATURE_ANGLE_DEGREES: f64 = 30.0;
+
+/// The validated surface of a solid from a geometry file: a surface (`.stl`, `.obj`) whose CAD
+/// faces come from the file (the STL facet attribute or `solid` blocks, OBJ groups), or the
+/// boundary of a tet mesh in any format amber reads. A surface with a single face (a plain STL,
+/// a mesh boundary) is split into faces at edges sharper than `feature_angle` degrees, since the
+/// generator keeps vertices on their own face and curves.
+pub fn read_solid_surface(path: &Path, feature_angle: f64) -> Result<Surface, TaskError> {
+    let geometry = |message: String| TaskError::Geometry { path: path.into(), message };
+    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let mut surface = match extension.as_deref() {
+        Some("stl" | "obj") => {
+            let soup = read_surface(path, StlFaceIds::FromFile).map_err(|e| geometry(e.to_string()))?;
+            Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(|e| geometry(e.to_string()))?
+        }
+        _ => {
+            let mesh = read_mesh::<3>(path).map_err(|e| geometry(format!("neither a surface nor a tet mesh: {e}")))?;
+            Surface::from_mesh_boundary(&mesh).map_err(|e| geometry(format!("boundary of the tet mesh: {e}")))?
+        }
+    };
+    if surface.face_ids().iter().all(|&id| id == surface.face_ids()[0]) {
+        surface.split_faces_at_feature_edges(feature_angle);
+    }
+    surface.validate().map_err(|e| geometry(format!("does not bound a solid: {e}")))?;
+    Ok(surface)
+}
+
+/// A planar domain from a geometry file: a polygon JSON `{"outer": [[x, y], ...], "holes":
+/// [...]}`, or the boundary of a triangle mesh in any format amber reads.
+pub fn read_polygon_domain(path: &Path) -> Result<PolygonDomain, TaskError> {
+    let geometry = |message: String| TaskError::Geometry { path: path.into(), message };
+    let is_json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    if is_json {
+        let bytes = std::fs::read(path).map_err(|source| TaskError::Io { path: path.into(), source })?;
+        let value: serde_json::Value =
+            serde_json::from_slice(&bytes).map_err(|source| TaskError::Json { path: path.into(), source })?;
+        if value.get("outer").is_some() {
+            return serde_json::from_value(value).map_err(|e| geometry(format!("not a valid polygon domain: {e}")));
+        }
+    }
+    let mesh = read_mesh::<2>(path).map_err(|e| geometry(format!("neither a polygon nor a triangle mesh: {e}")))?;
+    PolygonDomain::from_mesh_boundary(&mesh).map_err(|e| geometry(format!("boundary of the mesh: {e}")))
+}
+
+/// A solid to mesh: its bounding surface and M⁰.
+#[derive(Clone, Debug)]
+pub struct SolidPart {
+    /// What errors and reports call it (a file stem, or `split/NNN` for Console parts).
+    pub name: String,
+    /// The validated surface (CAD face ids per triangle) every new mesh is made from.
+    pub surface: Surface,
+    /// M⁰: a uniform mesh of the solid.
+    pub initial_mesh: Mesh3,
+}
+
+impl SolidPart {
+    /// Meshes M⁰ uniformly with size `initial_size` (no curvature cap, size factor 1: the Console
+    /// reference's uniform gmsh mesh, see `console::INITIAL_MESH_RECIPE`).
+    pub fn new(name: String, surface: Surface, initial_size: f64) -> Result<Self, Mesh3dError> {
+        let params = Mesh3dParams { curvature_tolerance: f64::INFINITY, size_factor: 1.0, ..Mesh3dParams::default() };
+        let initial_mesh = generate_3d(&surface, &ConstantSize(initial_size), &params)?;
+        Ok(Self { name, surface, initial_mesh })
+    }
+}
+
+impl Domain<3> for SolidPart {
+    /// Geometric features only: node [volume], edge [3D midpoint difference].
+    fn feature_set(&self) -> FeatureSet {
+        FeatureSet::console()
+    }
+
+    fn initial_mesh(&self) -> &Mesh<3> {
+        &self.initial_mesh
+    }
+
+    /// None: the features are geometric, computed by the graph.
+    fn columns(&self, _mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
+        Ok(Vec::new())
+    }
+
+    fn remesh(&self, mesh: &Mesh<3>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<3>, ProblemError> {
+        let params = Mesh3dParams::default().with_max_elements(max_elements);
+        generate_3d(&self.surface, &MeshSizing::new(mesh, sizes), &params)
+            .map_err(|e| ProblemError::Meshing(MeshgenError::from(e)))
+    }
+}
