@@ -340,6 +340,17 @@ mod tests {
     }
 
     #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        // Five items (one tile per image): in parallel at 1 and 2 threads, one after the other
+        // with multi-threaded products at 3. Forty items (five tiles per image): several per chunk.
+        for (n, c, spatial) in [(5, 4, [24, 32]), (8, 16, [64, 64])] {
+            let x = Image::random(n, c, &spatial, 1).tensor(DType::F32);
+            let w = tensor(&random_vec(8 * c * 9, 2), &[8, c, 3, 3], DType::F32);
+            assert_same_at_any_thread_count(|| autograd(&[x.clone(), w.clone()], &|t| probe_loss(&conv(&t[0], &t[1])?, 3)));
+        }
+    }
+
+    #[test]
     fn bad_shapes_are_errors() {
         let x = Image::random(1, 2, &[4, 4], 9).tensor(DType::F32);
         assert!(conv(&x, &tensor(&random_vec(3 * 3 * 9, 1), &[3, 3, 3, 3], DType::F32)).is_err());

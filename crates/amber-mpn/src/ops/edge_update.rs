@@ -223,9 +223,16 @@ mod tests {
     }
 
     #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        let topo = multi_block_graph();
+        let t = f32s(&inputs(&topo, 8));
+        assert_same_at_any_thread_count(|| autograd(&t, &fused(&topo)));
+    }
+
+    #[test]
     fn inference_path_equals_training_path() {
         let topo = multi_block_graph();
-        let t: Vec<Tensor> = inputs(&topo, 4).iter().map(|t| t.to_dtype(candle_core::DType::F32).unwrap()).collect();
+        let t = f32s(&inputs(&topo, 4));
         let plain = edge_update(&t[0], &t[1], &t[2], &topo).unwrap();
         let var = candle_core::Var::from_tensor(&t[1]).unwrap();
         let tracked = edge_update(&t[0], var.as_tensor(), &t[2], &topo).unwrap();

@@ -168,4 +168,10 @@ mod tests {
             assert_close(&autograd(&t, &fused), &autograd(&t, &composed), 1e-10);
         }
     }
+
+    #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        let t = f32s(&[random((2_000, 8), 1), random((2_000, 8), 2), random_theta(16, 8, 3)]);
+        assert_same_at_any_thread_count(|| autograd(&t, &fused));
+    }
 }
