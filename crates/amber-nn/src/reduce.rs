@@ -46,11 +46,6 @@ where
     parts.into_iter().reduce(combine).unwrap_or_else(identity)
 }
 
-/// `Σ values` in f64, summed by [`ordered_fold`]: the same at any thread count.
-pub fn ordered_sum(values: &[f64]) -> f64 {
-    ordered_fold(values.par_iter(), || 0.0, |s, &v| s + v, |a, b| a + b)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -75,8 +70,11 @@ mod tests {
                     a
                 },
             );
-            let expected: Vec<usize> =
-                c.iter().enumerate().flat_map(|(k, r)| (k > 0).then_some(usize::MAX).into_iter().chain(r.clone())).collect();
+            let expected: Vec<usize> = c
+                .iter()
+                .enumerate()
+                .flat_map(|(k, r)| (k > 0).then_some(usize::MAX).into_iter().chain(r.clone()))
+                .collect();
             assert_eq!(visited, expected, "len {len}");
         }
     }
@@ -84,14 +82,13 @@ mod tests {
     #[test]
     fn sums_are_the_same_at_any_thread_count() {
         // Magnitudes spread over many orders, so that any change of order changes the rounding.
-        let values: Vec<f64> = (0..10_000).map(|i| ((i * 7919 % 1000) as f64 - 500.0) * 10f64.powi(i % 17 - 8)).collect();
+        let values: Vec<f64> =
+            (0..10_000).map(|i| ((i * 7919 % 1000) as f64 - 500.0) * 10f64.powi(i % 17 - 8)).collect();
+        let sum = |values: &[f64]| ordered_fold(values.par_iter(), || 0.0, |s, &v| s + v, |a, b| a + b);
         let sums: Vec<u64> = (1..=4)
-            .map(|n| {
-                let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
-                pool.install(|| ordered_sum(&values)).to_bits()
-            })
+            .map(|n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap().install(|| sum(&values)).to_bits())
             .collect();
         assert!(sums.iter().all(|&s| s == sums[0]), "{sums:?}");
-        assert_eq!(ordered_sum(&[]), 0.0);
+        assert_eq!(sum(&[]), 0.0);
     }
 }
