@@ -241,10 +241,22 @@ impl UNet {
         Self::build(config, Source::Seeded(Box::new(ChaCha8Rng::seed_from_u64(seed))), DType::F32)
     }
 
-    /// The f32 network of a weights file written by [`Self::save`], with `config`.
+    /// The f32 network of a weights file written by [`Self::save`], with `config`. A tensor
+    /// missing, extra, of the wrong shape for `config` or with a non-finite entry, or a negative
+    /// BatchNorm running variance (whose square root would be NaN), is an error naming the file
+    /// and the tensor.
     pub fn load(config: UNetConfig, weights: &Path) -> Result<Self> {
-        let tensors = candle_core::safetensors::load(weights, &Device::Cpu)
-            .map_err(|e| CnnError::ModelFile { path: weights.into(), message: e.to_string() })?;
+        let file_error = |message: String| CnnError::ModelFile { path: weights.into(), message };
+        let tensors = candle_core::safetensors::load(weights, &Device::Cpu).map_err(|e| file_error(e.to_string()))?;
+        if let Some(name) = amber_nn::first_non_finite(&tensors).map_err(|e| file_error(e.to_string()))? {
+            return Err(file_error(format!("tensor `{name}` has a non-finite entry")));
+        }
+        for (name, t) in tensors.iter().filter(|(name, _)| name.ends_with(".running_var")) {
+            let values = t.to_dtype(DType::F64)?.flatten_all()?.to_vec1::<f64>()?;
+            if let Some(v) = values.iter().find(|v| **v < 0.0) {
+                return Err(file_error(format!("tensor `{name}` has a negative variance {v}")));
+            }
+        }
         Self::build(config, Source::File { path: weights.into(), tensors }, DType::F32)
     }
 

@@ -106,15 +106,21 @@ impl RunningMoments {
         Ok(())
     }
 
-    fn check(&self) -> Result<(), String> {
+    /// Checks moments read from a file: as many means as variances, a finite positive count
+    /// (the merge divides by it), finite means and finite non-negative variances (the square
+    /// root of a negative one is NaN). The message names the field and column at fault.
+    pub fn validate(&self) -> Result<(), String> {
         if self.mean.len() != self.var.len() {
             return Err(format!("{} means but {} variances", self.mean.len(), self.var.len()));
         }
         if !(self.count.is_finite() && self.count > 0.0) {
             return Err(format!("count {} is not positive", self.count));
         }
-        if self.mean.iter().any(|m| !m.is_finite()) || self.var.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-            return Err("non-finite mean or negative variance".into());
+        if let Some((k, m)) = self.mean.iter().enumerate().find(|(_, m)| !m.is_finite()) {
+            return Err(format!("mean of column {k} is {m}"));
+        }
+        if let Some((k, v)) = self.var.iter().enumerate().find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
+            return Err(format!("variance of column {k} is {v}"));
         }
         Ok(())
     }
@@ -161,13 +167,16 @@ impl FeatureNormaliser {
         let text = std::fs::read_to_string(path).map_err(|source| GraphError::Io { path: path.into(), source })?;
         let normaliser: Self =
             serde_json::from_str(&text).map_err(|source| GraphError::Json { path: path.into(), source })?;
-        for (name, moments) in [("node", &normaliser.node), ("edge", &normaliser.edge)] {
-            moments.check().map_err(|reason| GraphError::InvalidNormaliser {
-                path: path.into(),
-                reason: format!("{name}: {reason}"),
-            })?;
-        }
+        normaliser.validate().map_err(|reason| GraphError::InvalidNormaliser { path: path.into(), reason })?;
         Ok(normaliser)
+    }
+
+    /// [`RunningMoments::validate`] of both moments; the message starts with `node` or `edge`.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, moments) in [("node", &self.node), ("edge", &self.edge)] {
+            moments.validate().map_err(|reason| format!("{name}: {reason}"))?;
+        }
+        Ok(())
     }
 
     fn check_dims(&self, node_dim: usize, edge_dim: usize) -> Result<(), GraphError> {

@@ -165,7 +165,8 @@ impl<T: Real> MlpWeights<T> {
     }
 }
 
-/// Gradient accumulators matching [`MlpWeights`], summed over row blocks.
+/// Gradient accumulators matching [`MlpWeights`], summed over row blocks (in the fixed order of
+/// `amber_nn::reduce`, so that the sum is the same at any thread count).
 pub(crate) struct MlpGrads<T> {
     pub w1: Vec<T>,
     pub b1: Vec<T>,

@@ -172,12 +172,13 @@ impl Mpn {
     }
 
     /// Loads a checkpoint written by [`Mpn::save`] as plain f32 tensors on the CPU, for
-    /// inference.
+    /// inference. A tensor missing, extra, of the wrong shape for the configuration or with a
+    /// non-finite entry is an error naming the file and the tensor.
     pub fn load(path: &Path) -> Result<Self> {
         let (dtype, device) = (DType::F32, Device::Cpu);
         let config = read_config(path)?;
         let checkpoint_err = |e: candle_core::Error| MpnError::Checkpoint { path: path.into(), message: e.to_string() };
-        let tensors: HashMap<String, Tensor> = candle_core::safetensors::load(path, &device).map_err(checkpoint_err)?;
+        let tensors = read_tensors(path)?;
         let stored = tensors.len();
         let model = match Self::new(config, VarBuilder::from_tensors(tensors, dtype, &device)) {
             Err(MpnError::Candle(e)) => return Err(checkpoint_err(e)),
@@ -188,15 +189,13 @@ impl Mpn {
     }
 
     /// Loads a checkpoint written by [`Mpn::save`] into new f32 variables on the CPU, to resume
-    /// training.
+    /// training; checked as in [`Mpn::load`].
     pub fn load_trainable(path: &Path) -> Result<(Self, VarMap)> {
         let (model, mut varmap) = Self::init(read_config(path)?, 0, DType::F32, &Device::Cpu)?;
+        let stored = read_tensors(path)?.len();
         // `VarMap::load` overwrites the variables the model created (shape-checked); it would
         // load nothing into an empty map.
         varmap.load(path).map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })?;
-        let stored = candle_core::safetensors::load(path, &Device::Cpu)
-            .map_err(|e| MpnError::Checkpoint { path: path.into(), message: e.to_string() })?
-            .len();
         model.check_tensor_count(path, stored)?;
         Ok((model, varmap))
     }
@@ -331,7 +330,18 @@ fn read_config(path: &Path) -> Result<MpnConfig> {
     let json_path = path.with_extension("json");
     let text =
         std::fs::read_to_string(&json_path).map_err(|source| MpnError::Io { path: json_path.clone(), source })?;
-    let config: MpnConfig = serde_json::from_str(&text).map_err(|source| MpnError::Json { path: json_path, source })?;
-    config.validate()?;
+    let config: MpnConfig =
+        serde_json::from_str(&text).map_err(|source| MpnError::Json { path: json_path.clone(), source })?;
+    config.validate().map_err(|e| MpnError::Checkpoint { path: json_path, message: e.to_string() })?;
     Ok(config)
+}
+
+/// The tensors of a checkpoint, every entry finite.
+fn read_tensors(path: &Path) -> Result<HashMap<String, Tensor>> {
+    let checkpoint_err = |message: String| MpnError::Checkpoint { path: path.into(), message };
+    let tensors = candle_core::safetensors::load(path, &Device::Cpu).map_err(|e| checkpoint_err(e.to_string()))?;
+    if let Some(name) = amber_nn::first_non_finite(&tensors).map_err(|e| checkpoint_err(e.to_string()))? {
+        return Err(checkpoint_err(format!("tensor `{name}` has a non-finite entry")));
+    }
+    Ok(tensors)
 }

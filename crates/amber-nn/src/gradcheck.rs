@@ -1,6 +1,7 @@
 //! The finite-difference gradient check of custom ops (for tests): random inputs in f64, a
-//! probe loss that gives every output entry its own gradient, autograd of a loss, and central
-//! differences compared with autograd.
+//! probe loss that gives every output entry its own gradient, autograd of a loss, central
+//! differences compared with autograd, and the check that a computation gives the same bits at
+//! any thread count.
 
 use candle_core::{DType, Device, Result, Shape, Tensor, Var};
 use rand::rngs::StdRng;
@@ -52,6 +53,22 @@ pub fn check_finite_differences(inputs: &[Tensor], loss: &dyn Fn(&[Tensor]) -> R
             let fd = (eval(i, idx, eps) - eval(i, idx, -eps)) / (2.0 * eps);
             let err = (fd - grad[idx]).abs() / fd.abs().max(grad[idx].abs()).max(1.0);
             assert!(err < 1e-6, "input {i} entry {idx}: finite difference {fd}, autograd {}", grad[idx]);
+        }
+    }
+}
+
+/// Asserts that `f` returns the same values, bit for bit, in rayon pools of 1, 2 and 3 threads:
+/// what every op with a parallel reduction must do for training to be reproducible.
+pub fn assert_same_at_any_thread_count(f: impl Fn() -> Vec<Vec<f64>> + Send + Sync) {
+    let bits = |threads: usize| -> Vec<Vec<u64>> {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+        pool.install(|| f().iter().map(|v| v.iter().map(|x| x.to_bits()).collect()).collect())
+    };
+    let one = bits(1);
+    for threads in [2, 3] {
+        for (i, (a, b)) in one.iter().zip(bits(threads)).enumerate() {
+            let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+            assert!(a.len() == b.len() && differ == 0, "result {i}: {differ} values differ at {threads} threads");
         }
     }
 }

@@ -1,14 +1,20 @@
 //! What AMBER's two candle networks (the message passing network in `amber-mpn`, the U-Net in
 //! `amber-cnn`) share: [`Adam`] with global gradient-norm clipping whose moments can be saved and
 //! restored (so a resumed run continues exactly, and benchmarks time the optimiser that trains),
-//! the adapter that turns a kernel written as slice loops into a candle custom op ([`op`]), and
-//! the finite-difference gradient checker of both crates' op tests ([`gradcheck`]).
+//! the adapter that turns a kernel written as slice loops into a candle custom op ([`op`]), the
+//! parallel reductions whose result does not depend on the thread count, so that training is
+//! bit-reproducible at any number of threads ([`reduce`]), the finiteness check of a loaded
+//! weights file ([`first_non_finite`]), and the finite-difference gradient checker of both
+//! crates' op tests ([`gradcheck`]).
 //!
-//! This crate depends on candle only; it knows nothing of meshes, graphs, images or training
-//! loops.
+//! This crate depends on candle and rayon only; it knows nothing of meshes, graphs, images or
+//! training loops.
 
 mod adam;
+mod finite;
 pub mod gradcheck;
 pub mod op;
+pub mod reduce;
 
 pub use adam::{Adam, clip_grad_norm, grad_norm};
+pub use finite::first_non_finite;

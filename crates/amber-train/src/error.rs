@@ -38,6 +38,10 @@ pub enum TrainError {
     /// generator failed); `step` counts from 1.
     #[error("generation step {step}: {reason}")]
     Generation { step: usize, reason: String },
+    /// A model file holds values no model can have (non-finite or negative moments, limits that
+    /// are not positive) or that do not fit its network; the message names the field.
+    #[error("{path}: {message}")]
+    InvalidModel { path: PathBuf, message: String },
     /// A checkpoint is missing a piece or does not fit the run it should resume.
     #[error("checkpoint {path}: {message}")]
     Checkpoint { path: PathBuf, message: String },

@@ -10,10 +10,16 @@
 //! prints: progress goes through [`TrainingObserver`]; argument parsing and plotting belong to the
 //! binaries.
 //!
-//! Determinism: a run is a function of its configuration (seed included) and problems. With one
-//! rayon thread it is bit-for-bit reproducible, across resumes too; with more threads the
-//! network's parallel gradient reductions sum in a scheduling-dependent order, so runs agree only
-//! to rounding at first and then drift apart.
+//! Determinism: a run is a function of its configuration (seed included) and problems, bit for
+//! bit, at any number of rayon threads and across resumes: every parallel float reduction of the
+//! networks' ops (weight and bias gradients) sums in fixed chunks chosen by the size of the data
+//! alone and combines them in order (`amber_nn::reduce`), and everything else parallel here maps
+//! items independently and collects them in order (`tests/determinism.rs` compares the model
+//! files of runs at one and two threads).
+//!
+//! Model files are checked when read: non-finite weights, weights of the wrong shape for the
+//! configuration, moments with negative variances or a zero count and limits that are not
+//! positive are errors naming the file and the tensor or field.
 
 mod amber;
 mod checkpoint;
@@ -21,6 +27,7 @@ mod cnn;
 mod config;
 mod error;
 mod method;
+mod model_file;
 mod rollout;
 
 pub use amber::{

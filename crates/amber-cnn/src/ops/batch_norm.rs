@@ -228,6 +228,14 @@ mod tests {
     }
 
     #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        let x = Image::random(4, 8, &[16, 16], 5).tensor(DType::F32);
+        let (gamma, beta) = (tensor(&random_vec(8, 6), &[8], DType::F32), tensor(&random_vec(8, 7), &[8], DType::F32));
+        let loss = |t: &[Tensor]| probe_loss(&batch_norm_relu(&t[0], &t[1], &t[2], None)?.0, 8);
+        assert_same_at_any_thread_count(|| autograd(&[x.clone(), gamma.clone(), beta.clone()], &loss));
+    }
+
+    #[test]
     fn batch_statistics_are_reported_unbiased() {
         let x = tensor(&[1.0, 3.0, 10.0, 10.0], &[2, 2, 1, 1], DType::F32);
         let ones = tensor(&[1.0, 1.0], &[2], DType::F32);

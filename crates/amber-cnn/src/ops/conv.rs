@@ -4,7 +4,8 @@
 //! Forward: per tile of rows, im2col into a scratch matrix `(C·K) × T` and one gemm
 //! `W (O × C·K) · cols` written straight into the output. Backward: the input gradient is the
 //! same convolution of the output gradient with the flipped, transposed kernel; the weight
-//! gradient is `Σ dY_tile · colsᵀ` accumulated per thread.
+//! gradient is `Σ dY_tile · colsᵀ`, summed over the tiles in the fixed chunks of
+//! `amber_nn::reduce` (the same at any thread count).
 
 use amber_nn::op::{Fused, SliceOp};
 use candle_core::{Layout, Result, Shape, Tensor, bail};
@@ -337,6 +338,19 @@ mod tests {
         let x = Image::random(1, 2, &[3, 4, 2], 7).tensor(DType::F64);
         let w = tensor(&random_vec(3 * 2 * 27, 8), &[3, 2, 3, 3, 3], DType::F64);
         check_finite_differences(&[x, w], &|t| probe_loss(&conv(&t[0], &t[1])?, 99));
+    }
+
+    #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        // Five items (one tile per image): in parallel at 1 and 2 threads, one after the other
+        // with multi-threaded products at 3. Forty items (five tiles per image): several per chunk.
+        for (n, c, spatial) in [(5, 4, [24, 32]), (8, 16, [64, 64])] {
+            let x = Image::random(n, c, &spatial, 1).tensor(DType::F32);
+            let w = tensor(&random_vec(8 * c * 9, 2), &[8, c, 3, 3], DType::F32);
+            assert_same_at_any_thread_count(|| {
+                autograd(&[x.clone(), w.clone()], &|t| probe_loss(&conv(&t[0], &t[1])?, 3))
+            });
+        }
     }
 
     #[test]

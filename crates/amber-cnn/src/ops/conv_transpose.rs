@@ -249,6 +249,18 @@ mod tests {
     }
 
     #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        // Five items, then 34 (two tiles per image), as in the convolution's test.
+        for (n, c, o, spatial) in [(5, 8, 4, [16, 16]), (17, 4, 64, [32, 32])] {
+            let x = Image::random(n, c, &spatial, 1).tensor(DType::F32);
+            let w = tensor(&random_vec(c * o * 4, 2), &[c, o, 2, 2], DType::F32);
+            let b = tensor(&random_vec(o, 3), &[o], DType::F32);
+            let loss = |t: &[Tensor]| probe_loss(&conv_transpose2(&t[0], &t[1], &t[2])?, 4);
+            assert_same_at_any_thread_count(|| autograd(&[x.clone(), w.clone(), b.clone()], &loss));
+        }
+    }
+
+    #[test]
     fn mismatched_kernels_are_errors() {
         let x = Image::random(1, 2, &[2, 2], 7).tensor(DType::F32);
         let w = tensor(&random_vec(3 * 3 * 4, 1), &[3, 3, 2, 2], DType::F32);

@@ -2,6 +2,7 @@
 //! split the convolutions share: many small single-threaded products in parallel when there are
 //! enough tiles, else one multi-threaded product per tile.
 
+use amber_nn::reduce::{chunks, ordered_fold};
 use rayon::prelude::*;
 
 use super::Float;
@@ -105,7 +106,10 @@ pub(super) fn for_each_item<T: Float>(items: usize, work: impl Fn(usize, usize, 
 }
 
 /// Like [`for_each_item`], but every item adds into an accumulator of `len` zeros; returns the
-/// sum of all accumulators.
+/// sum of all accumulators. The items are summed in the chunks of `amber_nn::reduce` (one
+/// accumulator per chunk, the chunks added in order), whether the chunks run in parallel or one
+/// after the other: the sum is the same at any thread count (a product's own result does not
+/// depend on its threads, since `gemm` splits only the output between them).
 pub(super) fn sum_over_items<T: Float>(
     items: usize,
     len: usize,
@@ -113,24 +117,23 @@ pub(super) fn sum_over_items<T: Float>(
 ) -> Vec<T> {
     let threads = rayon::current_num_threads();
     let zeros = || vec![T::zero(); len];
+    let add = |mut a: Vec<T>, b: Vec<T>| {
+        a.iter_mut().zip(&b).for_each(|(a, &b)| *a += b);
+        a
+    };
     if items >= 2 * threads {
-        (0..items)
-            .into_par_iter()
-            .fold(
-                || (zeros(), Scratch::new()),
-                |(mut acc, mut scratch), i| {
-                    work(i, 1, &mut acc, &mut scratch);
-                    (acc, scratch)
-                },
-            )
-            .map(|(acc, _)| acc)
-            .reduce(zeros, |mut a, b| {
-                a.iter_mut().zip(&b).for_each(|(a, &b)| *a += b);
-                a
-            })
+        let fold = |(mut acc, mut scratch): (Vec<T>, Scratch<T>), i| {
+            work(i, 1, &mut acc, &mut scratch);
+            (acc, scratch)
+        };
+        ordered_fold((0..items).into_par_iter(), || (zeros(), Scratch::new()), fold, |(a, s), (b, _)| (add(a, b), s)).0
     } else {
-        let (mut acc, mut scratch) = (zeros(), Scratch::new());
-        (0..items).for_each(|i| work(i, threads, &mut acc, &mut scratch));
-        acc
+        let mut scratch = Scratch::new();
+        let sums = chunks(items).into_iter().map(|range| {
+            let mut acc = zeros();
+            range.for_each(|i| work(i, threads, &mut acc, &mut scratch));
+            acc
+        });
+        sums.reduce(add).unwrap_or_else(zeros)
     }
 }

@@ -197,6 +197,12 @@ mod tests {
     }
 
     #[test]
+    fn gradient_is_the_same_at_any_thread_count() {
+        let x = Image::random(4, 8, &[16, 16], 5).tensor(DType::F32);
+        assert_same_at_any_thread_count(|| autograd(std::slice::from_ref(&x), &|t| probe_loss(&max_pool2(&t[0])?, 6)));
+    }
+
+    #[test]
     fn too_small_inputs_are_errors() {
         assert!(max_pool2(&tensor(&[1.0, 2.0], &[1, 1, 1, 2], DType::F32)).is_err());
     }

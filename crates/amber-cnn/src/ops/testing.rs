@@ -1,7 +1,10 @@
 //! Test helpers: channel-major images in f64 for naive reference loops, random data, autograd
-//! of a probe loss, a relative comparison and (re-exported) `amber_nn`'s finite-difference check.
+//! of a probe loss, a relative comparison and (re-exported) `amber_nn`'s finite-difference and
+//! thread-count checks.
 
-pub use amber_nn::gradcheck::{check_finite_differences, probe_loss, values};
+pub use amber_nn::gradcheck::{
+    assert_same_at_any_thread_count, autograd, check_finite_differences, probe_loss, values,
+};
 use candle_core::{DType, Device, Tensor, Var};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -8,6 +8,7 @@
 use std::sync::Arc;
 
 use amber_nn::op::{Fused, SliceOp};
+use amber_nn::reduce::ordered_fold;
 use candle_core::{Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
@@ -126,27 +127,26 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
             bail!("edge_update: saved activations do not match the graph");
         }
 
-        let mut g = (
+        let blocks = (
             de.par_chunks_mut(chunk),
             dpre1.par_chunks_mut(chunk),
             gv.par_chunks(chunk),
             ev.par_chunks(chunk),
             mean.par_chunks(BLOCK_ROWS),
             rstd.par_chunks(BLOCK_ROWS),
-        )
-            .into_par_iter()
-            .fold(
-                || (MlpGrads::zeros(3 * d, d), vec![zero; 2 * chunk]),
-                |(mut g, mut scratch), (de, dpre1, gr, e, mean, rstd)| {
-                    let rows = e.len() / d;
-                    tail_backward(&w, gr, e, dpre1, de, mean, rstd, &mut scratch[..2 * rows * d], &mut g);
-                    matmul(rows, d, d, dpre1, false, w.w1_rows(2 * d..3 * d), true, de, true);
-                    matmul(d, rows, d, e, true, dpre1, false, &mut g.w1[2 * d * d..], true);
-                    (g, scratch)
-                },
-            )
-            .map(|(g, _)| g)
-            .reduce(|| MlpGrads::zeros(3 * d, d), MlpGrads::merge);
+        );
+        let (mut g, _) = ordered_fold(
+            blocks.into_par_iter(),
+            || (MlpGrads::zeros(3 * d, d), vec![zero; 2 * chunk]),
+            |(mut g, mut scratch), (de, dpre1, gr, e, mean, rstd)| {
+                let rows = e.len() / d;
+                tail_backward(&w, gr, e, dpre1, de, mean, rstd, &mut scratch[..2 * rows * d], &mut g);
+                matmul(rows, d, d, dpre1, false, w.w1_rows(2 * d..3 * d), true, de, true);
+                matmul(d, rows, d, e, true, dpre1, false, &mut g.w1[2 * d * d..], true);
+                (g, scratch)
+            },
+            |(a, scratch), (b, _)| (a.merge(b), scratch),
+        );
 
         // Gradients of the gathered node products: segment sums by source and by destination.
         let (mut dp, mut dq) = (vec![zero; n * d], vec![zero; n * d]);
@@ -156,27 +156,24 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
             segment_sum(dq, &dpre1, topo.dst_offsets(), None, b * BLOCK_ROWS, d);
         });
         let mut dx = vec![zero; n * d];
-        let dw_nodes = (dx.par_chunks_mut(chunk), dp.par_chunks(chunk), dq.par_chunks(chunk), xv.par_chunks(chunk))
-            .into_par_iter()
-            .fold(
-                || vec![zero; 2 * d * d],
-                |mut acc, (dx, dp, dq, x)| {
-                    let rows = x.len() / d;
-                    matmul(rows, d, d, dp, false, w.w1_rows(0..d), true, dx, false);
-                    matmul(rows, d, d, dq, false, w.w1_rows(d..2 * d), true, dx, true);
-                    let (acc_src, acc_dst) = acc.split_at_mut(d * d);
-                    matmul(d, rows, d, x, true, dp, false, acc_src, true);
-                    matmul(d, rows, d, x, true, dq, false, acc_dst, true);
-                    acc
-                },
-            )
-            .reduce(
-                || vec![zero; 2 * d * d],
-                |mut a, b| {
-                    add_assign(&mut a, &b);
-                    a
-                },
-            );
+        let blocks = (dx.par_chunks_mut(chunk), dp.par_chunks(chunk), dq.par_chunks(chunk), xv.par_chunks(chunk));
+        let dw_nodes = ordered_fold(
+            blocks.into_par_iter(),
+            || vec![zero; 2 * d * d],
+            |mut acc, (dx, dp, dq, x)| {
+                let rows = x.len() / d;
+                matmul(rows, d, d, dp, false, w.w1_rows(0..d), true, dx, false);
+                matmul(rows, d, d, dq, false, w.w1_rows(d..2 * d), true, dx, true);
+                let (acc_src, acc_dst) = acc.split_at_mut(d * d);
+                matmul(d, rows, d, x, true, dp, false, acc_src, true);
+                matmul(d, rows, d, x, true, dq, false, acc_dst, true);
+                acc
+            },
+            |mut a, b| {
+                add_assign(&mut a, &b);
+                a
+            },
+        );
         add_assign(&mut g.w1[..2 * d * d], &dw_nodes);
         Ok([Some(dx), Some(de), Some(g.pack(3 * d, d))])
     }
@@ -223,9 +220,16 @@ mod tests {
     }
 
     #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        let topo = multi_block_graph();
+        let t = f32s(&inputs(&topo, 8));
+        assert_same_at_any_thread_count(|| autograd(&t, &fused(&topo)));
+    }
+
+    #[test]
     fn inference_path_equals_training_path() {
         let topo = multi_block_graph();
-        let t: Vec<Tensor> = inputs(&topo, 4).iter().map(|t| t.to_dtype(candle_core::DType::F32).unwrap()).collect();
+        let t = f32s(&inputs(&topo, 4));
         let plain = edge_update(&t[0], &t[1], &t[2], &topo).unwrap();
         let var = candle_core::Var::from_tensor(&t[1]).unwrap();
         let tracked = edge_update(&t[0], var.as_tensor(), &t[2], &topo).unwrap();

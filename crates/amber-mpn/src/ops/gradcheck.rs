@@ -3,7 +3,9 @@
 
 use std::sync::Arc;
 
-pub use amber_nn::gradcheck::{autograd, check_finite_differences, probe_loss, random, values};
+pub use amber_nn::gradcheck::{
+    assert_same_at_any_thread_count, autograd, check_finite_differences, probe_loss, random, values,
+};
 use candle_core::Tensor;
 
 use crate::graph::Topology;
@@ -50,6 +52,11 @@ pub fn composed_residual_mlp(input: &Tensor, residual: &Tensor, theta: &Tensor) 
     let h = leaky_relu(&input.matmul(&w1.t()?)?.broadcast_add(&b1)?, 0.01)?;
     let h = leaky_relu(&h.matmul(&w2.t()?)?.broadcast_add(&b2)?, 0.01)?;
     layer_norm_slow(&(residual + h)?, &gamma, &beta, 1e-5)
+}
+
+/// The tensors in f32, the training dtype (whose rounding shows any change of summation order).
+pub fn f32s(t: &[Tensor]) -> Vec<Tensor> {
+    t.iter().map(|t| t.to_dtype(candle_core::DType::F32).unwrap()).collect()
 }
 
 pub fn random_theta(in_dim: usize, d: usize, seed: u64) -> Tensor {

@@ -3,7 +3,8 @@
 //! vectorised [`tanh`] for the decoder.
 //!
 //! Forward and backward are plain slice loops, parallel over blocks of rows with rayon, made
-//! candle ops by `amber_nn::op::Fused`. The ops keep the few intermediates their backward needs inside the op object, and only when an input
+//! candle ops by `amber_nn::op::Fused`; the weight gradients are summed over the blocks by
+//! `amber_nn::reduce::ordered_fold`, so they are the same bits at any thread count. The ops keep the few intermediates their backward needs inside the op object, and only when an input
 //! is tracked by autograd, so inference with plain tensors stores nothing.
 
 mod edge_update;

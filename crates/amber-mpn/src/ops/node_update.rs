@@ -2,6 +2,7 @@
 //! split into `x·W_x + a·W_a`.
 
 use amber_nn::op::{Fused, SliceOp};
+use amber_nn::reduce::ordered_fold;
 use candle_core::{Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
@@ -107,7 +108,7 @@ impl<T: Real> SliceOp<T, 3> for NodeUpdate {
         let zero = T::from_f64(0.0);
         let chunk = BLOCK_ROWS * d;
         let mut da = vec![zero; n * d];
-        let g = (
+        let blocks = (
             dx.par_chunks_mut(chunk),
             da.par_chunks_mut(chunk),
             h1.par_chunks_mut(chunk),
@@ -116,23 +117,22 @@ impl<T: Real> SliceOp<T, 3> for NodeUpdate {
             av.par_chunks(chunk),
             mean.par_chunks(BLOCK_ROWS),
             rstd.par_chunks(BLOCK_ROWS),
-        )
-            .into_par_iter()
-            .fold(
-                || (MlpGrads::zeros(2 * d, d), vec![zero; 2 * chunk]),
-                |(mut g, mut scratch), (dx, da, dpre1, gr, x, a, mean, rstd)| {
-                    let rows = x.len() / d;
-                    tail_backward(&w, gr, x, dpre1, dx, mean, rstd, &mut scratch[..2 * rows * d], &mut g);
-                    matmul(rows, d, d, dpre1, false, w.w1_rows(0..d), true, dx, true);
-                    matmul(rows, d, d, dpre1, false, w.w1_rows(d..2 * d), true, da, false);
-                    let (w1x, w1a) = g.w1.split_at_mut(d * d);
-                    matmul(d, rows, d, x, true, dpre1, false, w1x, true);
-                    matmul(d, rows, d, a, true, dpre1, false, w1a, true);
-                    (g, scratch)
-                },
-            )
-            .map(|(g, _)| g)
-            .reduce(|| MlpGrads::zeros(2 * d, d), MlpGrads::merge);
+        );
+        let (g, _) = ordered_fold(
+            blocks.into_par_iter(),
+            || (MlpGrads::zeros(2 * d, d), vec![zero; 2 * chunk]),
+            |(mut g, mut scratch), (dx, da, dpre1, gr, x, a, mean, rstd)| {
+                let rows = x.len() / d;
+                tail_backward(&w, gr, x, dpre1, dx, mean, rstd, &mut scratch[..2 * rows * d], &mut g);
+                matmul(rows, d, d, dpre1, false, w.w1_rows(0..d), true, dx, true);
+                matmul(rows, d, d, dpre1, false, w.w1_rows(d..2 * d), true, da, false);
+                let (w1x, w1a) = g.w1.split_at_mut(d * d);
+                matmul(d, rows, d, x, true, dpre1, false, w1x, true);
+                matmul(d, rows, d, a, true, dpre1, false, w1a, true);
+                (g, scratch)
+            },
+            |(a, scratch), (b, _)| (a.merge(b), scratch),
+        );
         Ok([Some(dx), Some(da), Some(g.pack(2 * d, d))])
     }
 }
@@ -167,5 +167,11 @@ mod tests {
             );
             assert_close(&autograd(&t, &fused), &autograd(&t, &composed), 1e-10);
         }
+    }
+
+    #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        let t = f32s(&[random((2_000, 8), 1), random((2_000, 8), 2), random_theta(16, 8, 3)]);
+        assert_same_at_any_thread_count(|| autograd(&t, &fused));
     }
 }

@@ -134,6 +134,13 @@ mod tests {
     }
 
     #[test]
+    fn gradients_are_the_same_at_any_thread_count() {
+        let topo = multi_block_graph();
+        let t = f32s(&[random((topo.num_edges(), 8), 1)]);
+        assert_same_at_any_thread_count(|| autograd(&t, &fused(&topo)));
+    }
+
+    #[test]
     fn isolated_nodes_get_zero() {
         let topo = corner_case_graph();
         let out = segment_mean(&random((topo.num_edges(), 3), 1), &topo).unwrap();

@@ -77,4 +77,10 @@ mod tests {
         let candle = |t: &[Tensor]| probe_loss(&t[0].tanh()?, 2);
         assert_close(&autograd(&t, &|t: &[Tensor]| probe_loss(&tanh(&t[0])?, 2)), &autograd(&t, &candle), 1e-12);
     }
+
+    #[test]
+    fn gradient_is_the_same_at_any_thread_count() {
+        let t = f32s(&[random((3_000, 16), 1).affine(3.0, 0.0).unwrap()]);
+        assert_same_at_any_thread_count(|| autograd(&t, &|t: &[Tensor]| probe_loss(&tanh(&t[0])?, 2)));
+    }
 }

@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use amber_graph::{FeatureNormaliser, FeatureSet, GraphBatch};
-use amber_mpn::{Mpn, MpnTrainer};
-use amber_stdx::{read_json, write_json_atomic};
+use amber_mpn::{Mpn, MpnConfig, MpnTrainer};
+use amber_stdx::write_json_atomic;
 use serde::{Deserialize, Serialize};
 
 use amber_mesh::Mesh;
@@ -13,6 +13,7 @@ use amber_tasks::{Domain, MeshLimits, MeshState};
 use rayon::prelude::*;
 
 use crate::error::{Result, in_problem, io_error};
+use crate::model_file::{check_limits, check_moments, read_checked};
 use crate::{PredictedField, SizingModel, TargetTransform};
 
 /// File of the network weights inside a model directory (its config is `model.json`).
@@ -32,6 +33,26 @@ pub struct Predictor {
 }
 
 impl Predictor {
+    /// Reads a `predictor.json` written with a network of configuration `network`, checking
+    /// that it is one ([`Self::validate`]); the error names the file and the field.
+    pub(crate) fn read(path: &Path, network: &MpnConfig) -> Result<Self> {
+        read_checked(path, |p: &Self| p.validate(network))
+    }
+
+    /// Checks what a file could get wrong: the normaliser and the target moments (finite,
+    /// non-negative variances, positive counts, one column per network input or one target) and
+    /// the limits (positive).
+    fn validate(&self, network: &MpnConfig) -> Result<(), String> {
+        if let Some(n) = &self.normaliser {
+            check_moments("normaliser.node", &n.node, network.node_features)?;
+            check_moments("normaliser.edge", &n.edge, network.edge_features)?;
+        }
+        if let Some(moments) = &self.target.moments {
+            check_moments("target.moments", moments, 1)?;
+        }
+        check_limits(&self.limits)
+    }
+
     /// Predicted element sizes for each state, from one batched forward pass of `network` in
     /// evaluation mode (no dropout, no autograd graph).
     pub fn predict<const D: usize>(&self, network: &Mpn, states: &[&MeshState<D>]) -> Result<Vec<Vec<f64>>> {
@@ -122,10 +143,12 @@ impl AmberModel {
     }
 
     /// Loads a model directory written by [`Self::save`] (a training checkpoint directory is
-    /// one too) for inference.
+    /// one too) for inference. Weights that are not finite or do not fit the network's
+    /// configuration, and a predictor with invalid moments or limits, are errors naming the
+    /// file and the tensor or field.
     pub fn load(dir: &Path) -> Result<Self> {
         let network = Mpn::load(&dir.join(WEIGHTS_FILE))?;
-        let predictor = read_json(&dir.join(PREDICTOR_FILE))?;
+        let predictor = Predictor::read(&dir.join(PREDICTOR_FILE), network.config())?;
         Ok(Self { network, predictor })
     }
 

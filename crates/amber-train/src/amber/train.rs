@@ -175,8 +175,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             return Err(fail("the training problems differ from the checkpointed run's".into()));
         }
         state.check(problems.len()).map_err(fail)?;
-        let predictor: Predictor = read_json(&dir.join(super::model::PREDICTOR_FILE))?;
         let mut trainer = MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.max_grad_norm)?;
+        let predictor = Predictor::read(&dir.join(super::model::PREDICTOR_FILE), trainer.network().config())?;
         trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
             records.par_iter().map(|r| checkpoint::load_entry(dir, r, &predictor.features, &predictor.target)).collect()

@@ -7,12 +7,13 @@ use amber_cnn::{CnnLoss, PixelGrid, Raster, UNet, UNetConfig};
 use amber_graph::{GraphError, NodeFeature, RunningMoments, VARIANCE_EPSILON};
 use amber_mesh::Mesh;
 use amber_meshgen::SizingField;
-use amber_stdx::{read_json, write_json_atomic};
+use amber_stdx::write_json_atomic;
 use amber_tasks::{Domain, MeshLimits};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, in_problem, io_error};
+use crate::model_file::{check_limits, check_moments, read_checked};
 use crate::{PredictedField, SizingModel};
 
 /// File of the U-Net weights (and BatchNorm statistics) inside a CNN model directory.
@@ -98,6 +99,29 @@ pub(super) fn transpose(data: &[f32], rows: usize, cols: usize) -> Vec<f32> {
 }
 
 impl CnnPredictor {
+    /// Reads a `cnn.json`, checking it ([`Self::validate`]); the error names the file and the
+    /// field.
+    pub(crate) fn read(path: &Path) -> Result<Self> {
+        read_checked(path, Self::validate)
+    }
+
+    /// Checks what a file could get wrong: the network's configuration, a positive resolution,
+    /// the input and label moments (finite, non-negative variances, positive counts, one column
+    /// per input channel or one label) and the limits (positive).
+    fn validate(&self) -> Result<(), String> {
+        self.network.validate().map_err(|e| format!("network: {e}"))?;
+        if self.resolution == 0 {
+            return Err("resolution is 0".into());
+        }
+        if let Some(moments) = &self.normaliser {
+            check_moments("normaliser", moments, self.network.in_channels)?;
+        }
+        if let Some(moments) = &self.label_moments {
+            check_moments("label_moments", moments, 1)?;
+        }
+        check_limits(&self.limits)
+    }
+
     /// The normalised network input of one rasterised problem, channel-major `C × pixels`.
     pub(super) fn input<const D: usize>(&self, sample: &Rasterised<D>) -> Result<Vec<f32>> {
         let (channels, pixels) = (self.network.in_channels, sample.raster.grid.len());
@@ -148,8 +172,11 @@ impl CnnModel {
     }
 
     /// Loads a model directory written by [`Self::save`] (a checkpoint directory is one too).
+    /// A predictor with invalid moments or limits and weights that are not
+    /// finite, not of the configuration's shapes or with a negative running variance are errors
+    /// naming the file and the field or tensor.
     pub fn load(dir: &Path) -> Result<Self> {
-        let predictor: CnnPredictor = read_json(&dir.join(CNN_PREDICTOR_FILE))?;
+        let predictor = CnnPredictor::read(&dir.join(CNN_PREDICTOR_FILE))?;
         let network = UNet::load(predictor.network.clone(), &dir.join(CNN_WEIGHTS_FILE))?;
         Ok(Self { network, predictor })
     }

@@ -182,7 +182,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         if state.problems != fingerprints(&problems) {
             return Err(fail("the training problems differ from the checkpointed run's"));
         }
-        let saved: CnnPredictor = read_json(&dir.join(CNN_PREDICTOR_FILE))?;
+        let saved = CnnPredictor::read(&dir.join(CNN_PREDICTOR_FILE))?;
         let (network, predictor, images) =
             Self::prepare(&config, &problems, |p| Ok(UNet::load(p.network.clone(), &dir.join(CNN_WEIGHTS_FILE))?))?;
         if saved != predictor {
