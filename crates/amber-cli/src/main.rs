@@ -1,8 +1,10 @@
 //! The `amber` command line.
 //!
 //! `amber mesh` turns a geometry and a sizing field into a mesh file or picture; `amber train`
-//! trains AMBER; `amber generate` meshes a problem with a trained model.
+//! trains AMBER; `amber generate` meshes a problem with a trained model; `amber convert`
+//! converts between mesh file formats.
 
+mod convert;
 mod mesh;
 mod train;
 
@@ -23,6 +25,8 @@ enum Command {
     Train(train::TrainArgs),
     /// Mesh a problem with a trained model: T generation steps from its initial mesh.
     Generate(train::GenerateArgs),
+    /// Convert a mesh file: .msh, .vtu, .vtk, .nas, .inp, .mesh, .json in, any of them out.
+    Convert(convert::ConvertArgs),
 }
 
 #[global_allocator]
@@ -38,5 +42,6 @@ fn main() -> anyhow::Result<()> {
         Command::Mesh(args) => mesh::run(args),
         Command::Train(args) => train::train(args),
         Command::Generate(args) => train::generate(args),
+        Command::Convert(args) => convert::run(args),
     }
 }

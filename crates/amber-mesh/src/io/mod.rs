@@ -26,7 +26,7 @@ mod vtu;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::{Mesh, MeshError};
+use crate::{Mesh, Mesh2, Mesh3, MeshError};
 
 /// What travels with a mesh in a file: named scalar fields with one value per element (`cell`)
 /// or per vertex (`point`), tags on boundary facets, and what a reader left out.
@@ -150,18 +150,57 @@ pub fn read_mesh<const D: usize>(path: impl AsRef<Path>) -> Result<Mesh<D>, Mesh
 /// Reads a mesh with the fields and facet tags stored with it, and what was dropped.
 pub fn read_mesh_with_data<const D: usize>(path: impl AsRef<Path>) -> Result<(Mesh<D>, MeshData), MeshError> {
     let path = path.as_ref();
+    match read_raw(path)? {
+        Parsed::Json(bytes) => json::read(path, &bytes),
+        Parsed::Raw(raw) => raw.finish(path),
+    }
+}
+
+/// A mesh in the dimension its file holds, with its data.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyMesh {
+    Two(Mesh2, MeshData),
+    Three(Mesh3, MeshData),
+}
+
+/// Reads a mesh whose dimension is not known in advance: the highest dimension of the file's
+/// elements decides (3: tetrahedra, 2: triangles). The file is parsed once.
+pub fn read_any_mesh(path: impl AsRef<Path>) -> Result<AnyMesh, MeshError> {
+    let path = path.as_ref();
+    match read_raw(path)? {
+        Parsed::Json(bytes) => match json::read::<3>(path, &bytes) {
+            Err(MeshError::DimensionMismatch { found: 2, .. }) => {
+                json::read(path, &bytes).map(|(mesh, data)| AnyMesh::Two(mesh, data))
+            }
+            read => read.map(|(mesh, data)| AnyMesh::Three(mesh, data)),
+        },
+        Parsed::Raw(raw) => match raw.dimension() {
+            2 => raw.finish(path).map(|(mesh, data)| AnyMesh::Two(mesh, data)),
+            // Anything else is a DimensionMismatch from `finish`, naming what the file holds.
+            _ => raw.finish(path).map(|(mesh, data)| AnyMesh::Three(mesh, data)),
+        },
+    }
+}
+
+/// A file parsed up to the point where the mesh dimension matters.
+enum Parsed {
+    Json(Vec<u8>),
+    Raw(raw::RawMesh),
+}
+
+fn read_raw(path: &Path) -> Result<Parsed, MeshError> {
     let format =
         format_of(path).ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: FORMATS })?;
     let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
-    match format {
-        Format::Json => json::read(path, &bytes),
-        Format::Vtu => vtu::read(path, &bytes)?.finish(path),
-        Format::Vtk => vtk::read(path, &bytes)?.finish(path),
-        Format::Msh => msh::read(path, &bytes)?.finish(path),
-        Format::Nastran => nastran::read(path, &bytes)?.finish(path),
-        Format::Abaqus => abaqus::read(path, &bytes)?.finish(path),
-        Format::Medit => medit::read(path, &bytes)?.finish(path),
-    }
+    Ok(Parsed::Raw(match format {
+        Format::Json => return Ok(Parsed::Json(bytes)),
+        Format::Vtu => vtu::read(path, &bytes)?,
+        Format::Vtk => vtk::read(path, &bytes)?,
+        Format::Msh => msh::read(path, &bytes)?,
+        Format::Nastran => nastran::read(path, &bytes)?,
+        Format::Abaqus => abaqus::read(path, &bytes)?,
+        Format::Medit => medit::read(path, &bytes)?,
+    }))
 }
 
 /// Where the face ids of an STL file come from.

@@ -59,12 +59,17 @@ impl RawMesh {
         &self.nodes[if i == 0 { 0 } else { self.ends[i - 1] }..self.ends[i]]
     }
 
+    /// The highest dimension of the cells (0 without cells).
+    pub(super) fn dimension(&self) -> usize {
+        self.kinds.iter().map(|k| k.dim).max().unwrap_or(0)
+    }
+
     /// Builds the `D`-dimensional mesh: fails with [`MeshError::DimensionMismatch`] when the
     /// highest cell dimension is not `D` (so a caller can try the other), keeps the linear
     /// `D`-simplices with their cell data, records tagged `(D-1)`-simplices as facet tags and
     /// counts every other cell in [`MeshData::dropped`].
     pub(super) fn finish<const D: usize>(self, path: &Path) -> Result<(Mesh<D>, MeshData), MeshError> {
-        let found = self.kinds.iter().map(|k| k.dim).max().unwrap_or(0);
+        let found = self.dimension();
         if found != D {
             return Err(MeshError::DimensionMismatch { path: path.to_owned(), expected: D, found });
         }
