@@ -48,7 +48,7 @@ def gmsh_model(dim):
 
 def reference(dim, directory):
     """The gmsh mesh as (points, cells, size), and the path of the same mesh as amber JSON."""
-    gmsh.model.remove() if gmsh.model.list() else None
+    restart_gmsh()
     gmsh_model(dim)
     path = os.path.join(directory, f"gmsh{dim}.msh")
     gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
@@ -69,30 +69,34 @@ def reference(dim, directory):
 
 
 def amber_convert(src, dst, *flags):
-    run = subprocess.run([AMBER, "convert", src, dst, *flags], capture_output=True, text=True)
+    env = dict(os.environ, RUST_BACKTRACE="0")
+    run = subprocess.run([AMBER, "convert", src, dst, *flags], capture_output=True, text=True, env=env)
     if run.returncode != 0:
         raise RuntimeError(run.stderr.strip())
 
 
-def same_points(expected, got):
+def same_points(expected, got, tol=TOL):
     """Same points to TOL, in order or (for tools that renumber) as sorted sets."""
     expected, got = np.asarray(expected, float), np.asarray(got, float)
     if expected.shape != got.shape:
         raise AssertionError(f"{len(got)} points, expected {len(expected)}")
-    if np.abs(expected - got).max() <= TOL:
+    if np.abs(expected - got).max() <= tol:
         return
-    order = lambda p: p[np.lexsort(p.T[::-1])]
+    order = lambda p: p[np.lexsort(np.round(p, 5).T[::-1])]
     diff = np.abs(order(expected) - order(got)).max()
-    if diff > TOL:
+    if diff > tol:
         raise AssertionError(f"coordinates differ by {diff}")
 
 
 def same_cells(expected_points, expected, got_points, got):
-    """Same elements as sets of corner coordinates (independent of numbering and orientation)."""
-    key = lambda pts, cells: sorted(tuple(sorted(map(tuple, np.round(pts[c], 9)))) for c in cells)
+    """Same elements, each matched through its nearest expected vertices (independent of
+    numbering and orientation)."""
     if len(expected) != len(got):
         raise AssertionError(f"{len(got)} elements, expected {len(expected)}")
-    if key(np.asarray(expected_points), expected) != key(np.asarray(got_points), got):
+    expected_points, got_points = np.asarray(expected_points), np.asarray(got_points)
+    nearest = np.array([np.argmin(((expected_points - p) ** 2).sum(axis=1)) for p in got_points])
+    key = lambda cells: sorted(tuple(sorted(c)) for c in np.asarray(cells).tolist())
+    if key(expected) != key(nearest[np.asarray(got)]):
         raise AssertionError("different elements")
 
 
@@ -103,17 +107,34 @@ def same_values(expected, got, what):
         raise AssertionError(f"{what} differs")
 
 
-def check_amber_json(path, dim, points, cells, size):
+def check_amber_json(path, dim, points, cells, size, tol=TOL):
     with open(path) as f:
         m = json.load(f)
     if m["dimension"] != dim:
         raise AssertionError(f"dimension {m['dimension']}")
     got_points = np.zeros((len(m["vertices"]), 3))
     got_points[:, :dim] = m["vertices"]
-    same_points(points, got_points)
+    same_points(points, got_points, tol)
     same_cells(points, cells, got_points, np.array(m["elements"]))
     if size is not None:
         same_values(size, m.get("cell_data", {}).get("size"), "cell data `size`")
+
+
+def as_read_by_meshio(path, dim):
+    """What meshio reads from a file (points, simplices, `size`), the truth for files that round
+    their numbers (meshio's ASCII .vtu keeps 12 digits); None where meshio cannot read it."""
+    try:
+        m = meshio_read(path)
+    except (Exception, SystemExit):  # noqa: BLE001 - fall back to the reference mesh
+        return None
+    got = np.concatenate([c.data for c in m.cells if c.type == SIMPLEX[dim]])
+    points = np.zeros((len(m.points), 3))
+    points[:, : m.points.shape[1]] = m.points
+    used = np.unique(got)
+    remap = -np.ones(len(points), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    blocks = [np.ravel(d) for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == SIMPLEX[dim]]
+    return points[used], remap[got], np.concatenate(blocks) if blocks else None
 
 
 def meshio_inputs(dim, points, cells, size, directory):
@@ -137,11 +158,14 @@ def meshio_inputs(dim, points, cells, size, directory):
     add("vtk", "binary 5.1", "b.vtk", lambda p: meshio.vtk.write(p, mesh3, binary=True))
     add("vtk", "ascii 4.2", "a42.vtk", lambda p: meshio.vtk.write(p, mesh3, binary=False, fmt_version="4.2"))
     add("vtk", "binary 4.2", "b42.vtk", lambda p: meshio.vtk.write(p, mesh3, binary=True, fmt_version="4.2"))
+    # meshio 5.3 writes ASCII $ElementData values as `np.float64(0.1)` under numpy 2: those
+    # files carry no cell data here.
+    bare = meshio.Mesh(points, [(SIMPLEX[dim], cells)])
     for version, name in [("gmsh22", "2.2"), ("gmsh", "4.1")]:
         for binary in [False, True]:
             enc = f"{name} {'binary' if binary else 'ascii'}"
             add("msh", enc, f"{version}-{int(binary)}.msh",
-                lambda p, v=version, b=binary: meshio.write(p, mesh3, file_format=v, binary=b))
+                lambda p, v=version, b=binary: meshio.write(p, mesh3 if b else bare, file_format=v, binary=b), binary)
     add("nas", "ascii", "a.nas", lambda p: meshio.write(p, mesh3, file_format="nastran"), data=False)
     add("inp", "ascii", "a.inp", lambda p: meshio.write(p, mesh, file_format="abaqus"), data=False)
     add("mesh", "ascii", "a.mesh", lambda p: meshio.write(p, mesh, file_format="medit"), data=False)
@@ -151,6 +175,7 @@ def meshio_inputs(dim, points, cells, size, directory):
 def gmsh_inputs(dim, size, directory):
     """Files gmsh writes from the reference model; .msh files get `size` appended as a view."""
     out = []
+    gmsh.option.setNumber("PostProcessing.SaveMesh", 0)
     for version in ["2.2", "4.1"]:
         for binary in [0, 1]:
             path = os.path.join(directory, f"gmsh{dim}-{version}-{binary}.msh")
@@ -174,22 +199,35 @@ def gmsh_inputs(dim, size, directory):
     return out
 
 
+def meshio_read(path):
+    """meshio.read, told that .msh is gmsh (else a failure tries ANSYS and exits the process)."""
+    return meshio.read(path, file_format="gmsh" if path.endswith(".msh") else None)
+
+
 def read_with_meshio(path, dim, points, cells, size, has_data, physical):
-    m = meshio.read(path)
+    m = meshio_read(path)
     got = np.concatenate([c.data for c in m.cells if c.type == SIMPLEX[dim]])
     got_points = np.zeros((len(m.points), 3))
     got_points[:, : m.points.shape[1]] = m.points
     same_points(points, got_points)
     same_cells(points, cells, got_points, got)
     if has_data:
-        blocks = [d for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == SIMPLEX[dim]]
+        blocks = [np.ravel(d) for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == SIMPLEX[dim]]
         same_values(size, np.concatenate(blocks) if blocks else None, "cell data `size`")
     if physical and not {"domain", "boundary"} <= set(m.field_data):
         raise AssertionError(f"physical names {sorted(m.field_data)}")
 
 
+def restart_gmsh():
+    """A fresh gmsh: after a failed open gmsh 4.15 stays "busy" and ignores the next ones."""
+    if gmsh.isInitialized():
+        gmsh.finalize()
+    gmsh.initialize(readConfigFiles=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+
+
 def read_with_gmsh(path, dim, points, cells, physical):
-    gmsh.clear()
+    restart_gmsh()
     gmsh.open(path)
     tags, coords, _ = gmsh.model.mesh.getNodes()
     got_points = np.asarray(coords).reshape(-1, 3)
@@ -212,12 +250,10 @@ def main():
         try:
             check()
             results.append((fmt, encoding, direction, tool, "pass", ""))
-        except Exception as e:  # noqa: BLE001 - every failure is a table row
+        except (Exception, SystemExit) as e:  # noqa: BLE001 - every failure is a table row
             detail = str(e).splitlines()[-1] if str(e) else traceback.format_exc().splitlines()[-1]
             results.append((fmt, encoding, direction, tool, "FAIL", detail[:90]))
 
-    gmsh.initialize(readConfigFiles=False)
-    gmsh.option.setNumber("General.Terminal", 0)
     with tempfile.TemporaryDirectory() as directory:
         for dim in [2, 3]:
             points, cells, size, ref = reference(dim, directory)
@@ -228,7 +264,14 @@ def main():
 
                 def read_check(path=path, out=out, has_data=has_data):
                     amber_convert(path, out)
-                    check_amber_json(out, dim, points, cells, size if has_data else None)
+                    if path.endswith(".bdf"):
+                        # gmsh writes 8-character fields (7 digits), which meshio misreads
+                        # when they touch: compare with the reference to 1e-6.
+                        check_amber_json(out, dim, points, cells, None, 1e-6)
+                        return
+                    expected = as_read_by_meshio(path, dim) or (points, cells, size)
+                    expected_size = expected[2] if expected[2] is not None else size
+                    check_amber_json(out, dim, *expected[:2], expected_size if has_data else None)
 
                 record(fmt, f"{encoding} {dim}D", "read", tool, read_check)
             outputs = [("vtu", "binary", ["--binary"]), ("vtu", "ascii", ["--ascii"]), ("vtk", "ascii", []),
@@ -244,7 +287,8 @@ def main():
                     continue
                 record(fmt, f"{encoding} {dim}D", "write", "meshio",
                        lambda: read_with_meshio(path, dim, points, cells, size, has_data, fmt == "msh"))
-                if fmt in ("msh", "vtk", "mesh", "nas"):
+                # gmsh 4.15 fails to read binary legacy VTK, even the files it writes itself.
+                if fmt in ("msh", "mesh", "nas") or (fmt, encoding) == ("vtk", "ascii"):
                     record(fmt, f"{encoding} {dim}D", "write", "gmsh",
                            lambda: read_with_gmsh(path, dim, points, cells, fmt == "msh"))
     gmsh.finalize()

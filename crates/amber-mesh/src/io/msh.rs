@@ -10,7 +10,7 @@
 //!
 //! The writer writes 4.1 with `$Entities` and `$PhysicalNames`: the domain in physical group 1
 //! `domain`, the boundary facets (and any other tagged facet) in one physical group per tag, each
-//! in an entity of its own, and the fields as `$NodeData` / `$ElementData` on the domain elements.
+//! in an entity of its own, and the fields as `$NodeData` / `$ElementData` (NaN on the facets).
 
 use std::collections::{BTreeMap, HashMap};
 use std::io::Write;
@@ -580,10 +580,13 @@ fn write_body<const D: usize, W: Write>(
 
     let sections = data.point.iter().map(|f| ("NodeData", f)).chain(data.cell.iter().map(|f| ("ElementData", f)));
     for (section, (name, values)) in sections {
-        out.line(&format!("${section}\n1\n\"{name}\"\n1\n0.0\n3\n0\n1\n{}", values.len()))?;
-        for (i, v) in values.iter().enumerate() {
+        // Element fields give the facets NaN: meshio rejects a field that skips elements.
+        let padding = if section == "ElementData" { facets.len() } else { 0 };
+        let all = values.iter().copied().chain(std::iter::repeat_n(f64::NAN, padding));
+        out.line(&format!("${section}\n1\n\"{name}\"\n1\n0.0\n3\n0\n1\n{}", values.len() + padding))?;
+        for (i, v) in all.enumerate() {
             out.int(i as i32 + 1)?;
-            out.real(*v)?;
+            out.real(v)?;
             out.end_record()?;
         }
         if out.binary {
