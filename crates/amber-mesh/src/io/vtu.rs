@@ -385,7 +385,7 @@ fn data_array<T: Number>(
         T::VTK
     )?;
     if encoding == Encoding::Binary {
-        let mut bytes = Vec::with_capacity(values.len() * size_of::<T>());
+        let mut bytes = Vec::with_capacity(size_of_val(values));
         for v in values {
             v.put(false, &mut bytes);
         }
