@@ -302,7 +302,8 @@ fn block(bytes: &[u8], header: &Header) -> Result<Vec<u8>, String> {
     let word = |i: usize| -> Result<usize, String> {
         let b = bytes.get(i * h..(i + 1) * h).ok_or("truncated block header")?;
         let x = header.header.decode(b, header.big_endian)[0];
-        as_index(x).map(|x| x as usize).or((x < 1e15).then_some(x as usize)).ok_or(format!("block header value {x}"))
+        // Header words are unsigned; anything near 2^50 is corrupt, not a size.
+        (x < 1e15).then_some(x as usize).ok_or(format!("block header value {x}"))
     };
     if !header.compressed {
         let n = word(0)?;
