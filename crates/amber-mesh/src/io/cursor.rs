@@ -70,28 +70,28 @@ impl Scalar {
     /// Decodes `bytes` (a whole number of values) into f64s; 64-bit integers above 2^53 lose
     /// precision, which no index or count of a mesh that fits in memory reaches.
     pub(super) fn decode(self, bytes: &[u8], big_endian: bool) -> Vec<f64> {
-        macro_rules! each {
-            ($t:ty) => {
-                bytes
-                    .chunks_exact(size_of::<$t>())
-                    .map(|b| {
-                        let b = b.try_into().expect("chunks_exact gives whole values");
-                        (if big_endian { <$t>::from_be_bytes(b) } else { <$t>::from_le_bytes(b) }) as f64
-                    })
-                    .collect()
-            };
+        bytes.chunks_exact(self.size()).map(|b| self.decode_one(b, big_endian)).collect()
+    }
+
+    /// Decodes one value from exactly `self.size()` bytes.
+    fn decode_one(self, b: &[u8], big_endian: bool) -> f64 {
+        macro_rules! one {
+            ($t:ty) => {{
+                let b = b.try_into().expect("the caller passes exactly one value");
+                (if big_endian { <$t>::from_be_bytes(b) } else { <$t>::from_le_bytes(b) }) as f64
+            }};
         }
         match self {
-            Self::I8 => each!(i8),
-            Self::U8 => each!(u8),
-            Self::I16 => each!(i16),
-            Self::U16 => each!(u16),
-            Self::I32 => each!(i32),
-            Self::U32 => each!(u32),
-            Self::I64 => each!(i64),
-            Self::U64 => each!(u64),
-            Self::F32 => each!(f32),
-            Self::F64 => each!(f64),
+            Self::I8 => one!(i8),
+            Self::U8 => one!(u8),
+            Self::I16 => one!(i16),
+            Self::U16 => one!(u16),
+            Self::I32 => one!(i32),
+            Self::U32 => one!(u32),
+            Self::I64 => one!(i64),
+            Self::U64 => one!(u64),
+            Self::F32 => one!(f32),
+            Self::F64 => one!(f64),
         }
     }
 }
@@ -241,7 +241,8 @@ impl<'a> Cursor<'a> {
 
     /// One binary value of type `ty`.
     pub(super) fn value(&mut self, ty: Scalar, what: &str) -> Result<f64, MeshError> {
-        Ok(self.values(ty, 1, what)?[0])
+        let big_endian = self.big_endian;
+        Ok(ty.decode_one(self.take(ty.size(), what)?, big_endian))
     }
 }
 

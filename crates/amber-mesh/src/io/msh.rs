@@ -99,6 +99,48 @@ impl Body<'_> {
     }
 }
 
+/// Tag → index: a vector when the tags are dense (gmsh numbers 1..n), else a hash map; a
+/// million-element file resolves its three million node references several times faster so.
+enum TagIndex {
+    Dense(Vec<u32>),
+    Sparse(HashMap<u64, u32>),
+}
+
+impl TagIndex {
+    /// Fails with the first tag given twice.
+    fn new(tags: &[u64]) -> Result<Self, u64> {
+        let max = tags.iter().copied().max().unwrap_or(0);
+        if max <= 2 * tags.len() as u64 + 16 {
+            let mut index = vec![u32::MAX; max as usize + 1];
+            for (i, &tag) in tags.iter().enumerate() {
+                if std::mem::replace(&mut index[tag as usize], i as u32) != u32::MAX {
+                    return Err(tag);
+                }
+            }
+            return Ok(TagIndex::Dense(index));
+        }
+        let mut index = HashMap::with_capacity(tags.len());
+        for (i, &tag) in tags.iter().enumerate() {
+            if index.insert(tag, i as u32).is_some() {
+                return Err(tag);
+            }
+        }
+        Ok(TagIndex::Sparse(index))
+    }
+
+    /// The same, the last of repeated tags winning.
+    fn last_wins(tags: &[u64]) -> Self {
+        TagIndex::Sparse(tags.iter().enumerate().map(|(i, &t)| (t, i as u32)).collect())
+    }
+
+    fn get(&self, tag: u64) -> Option<u32> {
+        match self {
+            TagIndex::Dense(index) => index.get(tag as usize).copied().filter(|&i| i != u32::MAX),
+            TagIndex::Sparse(index) => index.get(&tag).copied(),
+        }
+    }
+}
+
 /// A `$NodeData` / `$ElementData` section with the tags it gives values for.
 struct DataSection {
     on_elements: bool,
@@ -111,7 +153,6 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut body = Body { c: Cursor::new(path, bytes), binary: false };
     let mut version = None;
     let mut raw = RawMesh::default();
-    let mut node_index: HashMap<u64, u32> = HashMap::new();
     let mut node_tags: Vec<u64> = Vec::new();
     let mut element_tags: Vec<u64> = Vec::new();
     // Element nodes as node tags, resolved once every node is known.
@@ -144,7 +185,7 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                 body.end(name)?;
             }
             "Entities" if version == Some(true) => read_entities(&mut body, &mut entity_physical)?,
-            "Nodes" => read_nodes(&mut body, version == Some(true), &mut raw.points, &mut node_index, &mut node_tags)?,
+            "Nodes" => read_nodes(&mut body, version == Some(true), &mut raw.points, &mut node_tags)?,
             "Elements" => read_elements(
                 &mut body,
                 version == Some(true),
@@ -166,27 +207,26 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     if version.is_none() {
         return Err(body.c.error("empty file"));
     }
+    let node_index = TagIndex::new(&node_tags)
+        .map_err(|tag| MeshError::Format { path: path.to_owned(), message: format!("node {tag} is defined twice") })?;
     raw.nodes = element_nodes
         .iter()
-        .map(|tag| {
-            node_index.get(tag).copied().ok_or_else(|| MeshError::Format {
+        .map(|&tag| {
+            node_index.get(tag).ok_or_else(|| MeshError::Format {
                 path: path.to_owned(),
                 message: format!("an element references node {tag}, which $Nodes does not define"),
             })
         })
         .collect::<Result<_, _>>()?;
-    let element_index: HashMap<u64, usize> = element_tags.iter().enumerate().map(|(i, &t)| (t, i)).collect();
+    // Element tags are unique within a file that gmsh reads; the last one wins otherwise.
+    let element_index = TagIndex::new(&element_tags).unwrap_or_else(|_| TagIndex::last_wins(&element_tags));
     for s in sections {
-        let len = if s.on_elements { element_tags.len() } else { node_tags.len() };
+        let (len, index) =
+            if s.on_elements { (element_tags.len(), &element_index) } else { (node_tags.len(), &node_index) };
         let mut field = vec![f64::NAN; len];
         for (tag, value) in s.values {
-            let index = if s.on_elements {
-                element_index.get(&(tag as u64)).copied()
-            } else {
-                node_index.get(&(tag as u64)).map(|&i| i as usize)
-            };
-            if let Some(i) = index {
-                field[i] = value;
+            if let Some(i) = u64::try_from(tag).ok().and_then(|t| index.get(t)) {
+                field[i as usize] = value;
             }
         }
         if s.on_elements {
@@ -228,20 +268,10 @@ fn read_entities(body: &mut Body, physical: &mut HashMap<(i64, i64), i32>) -> Re
     body.end("Entities")
 }
 
-fn read_nodes(
-    body: &mut Body,
-    v41: bool,
-    points: &mut Vec<[f64; 3]>,
-    index: &mut HashMap<u64, u32>,
-    tags: &mut Vec<u64>,
-) -> Result<(), MeshError> {
-    let mut add = |body: &mut Body, tag: u64, p: [f64; 3]| {
-        if index.insert(tag, points.len() as u32).is_some() {
-            return Err(body.c.error(format!("node {tag} is defined twice")));
-        }
+fn read_nodes(body: &mut Body, v41: bool, points: &mut Vec<[f64; 3]>, tags: &mut Vec<u64>) -> Result<(), MeshError> {
+    let mut add = |tag: u64, p: [f64; 3]| {
         tags.push(tag);
         points.push(p);
-        Ok(())
     };
     if v41 {
         let blocks = body.size("number of node blocks")?;
@@ -260,7 +290,7 @@ fn read_nodes(
             let block_tags = (0..count).map(|_| body.size("node tag")).collect::<Result<Vec<_>, _>>()?;
             for tag in block_tags {
                 let p = [body.real("x coordinate")?, body.real("y coordinate")?, body.real("z coordinate")?];
-                add(body, tag, p)?;
+                add(tag, p);
             }
             read += announced;
         }
@@ -273,7 +303,7 @@ fn read_nodes(
         for _ in 0..body.count(announced, 8, 28, "nodes")? {
             let tag = body.int("node tag")? as u64;
             let p = [body.real("x coordinate")?, body.real("y coordinate")?, body.real("z coordinate")?];
-            add(body, tag, p)?;
+            add(tag, p);
         }
     }
     body.end("Nodes")
@@ -732,6 +762,8 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
         let missing = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 1 1 1\n2 1 0 1\n1\n0 0 0\n$EndNodes\n\
 $Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n";
         assert!(parse::<2>(missing).unwrap_err().to_string().contains("node 2"));
+        let twice = missing.replace("1 1 1 1\n2 1 0 1\n1\n0 0 0\n", "1 2 1 1\n2 1 0 2\n1\n1\n0 0 0\n1 0 0\n");
+        assert!(parse::<2>(&twice).unwrap_err().to_string().contains("node 1 is defined twice"));
         let off_plane = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 3 1 3\n2 1 0 3\n1\n2\n3\n0 0 0.5\n1 0 0\n0 1 0\n\
 $EndNodes\n$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n";
         assert!(parse::<2>(off_plane).unwrap_err().to_string().contains("plane z = 0"));
