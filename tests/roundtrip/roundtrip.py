@@ -9,10 +9,12 @@ write: `amber convert` writes a reference mesh (JSON with `size`) in every forma
        (to 1e-12), `size` preserved (meshio, where the format stores cell data), physical groups
        present (.msh).
 
-Prints a table format x encoding x direction x tool -> pass/fail and exits non-zero on any
-failure. Usage: roundtrip.py [AMBER_BINARY] (default: $AMBER_BIN, else target/debug/amber).
+Prints a table format x encoding x direction x tool -> pass/fail (the tool that wrote the file
+for `read`, the one that read amber's file for `write`) and exits non-zero on any failure. Usage: roundtrip.py [AMBER_BINARY] (default: $AMBER_BIN, else target/debug/amber).
 """
 
+import contextlib
+import io
 import json
 import os
 import subprocess
@@ -124,7 +126,8 @@ def as_read_by_meshio(path, dim):
     """What meshio reads from a file (points, simplices, `size`), the truth for files that round
     their numbers (meshio's ASCII .vtu keeps 12 digits); None where meshio cannot read it."""
     try:
-        m = meshio_read(path)
+        with contextlib.redirect_stdout(io.StringIO()):  # meshio prints its failures
+            m = meshio_read(path)
     except (Exception, SystemExit):  # noqa: BLE001 - fall back to the reference mesh
         return None
     got = np.concatenate([c.data for c in m.cells if c.type == SIMPLEX[dim]])
