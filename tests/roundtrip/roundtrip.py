@@ -10,7 +10,8 @@ write: `amber convert` writes a reference mesh (JSON with `size`) in every forma
        present (.msh).
 
 Prints a table format x encoding x direction x tool -> pass/fail (the tool that wrote the file
-for `read`, the one that read amber's file for `write`) and exits non-zero on any failure. Usage: roundtrip.py [AMBER_BINARY] (default: $AMBER_BIN, else target/debug/amber).
+for `read`, the one that read amber's file for `write`) and exits non-zero on any failure.
+Usage: roundtrip.py [AMBER_BINARY] (default: $AMBER_BIN, else target/debug/amber).
 """
 
 import contextlib
@@ -126,7 +127,8 @@ def as_read_by_meshio(path, dim):
     """What meshio reads from a file (points, simplices, `size`), the truth for files that round
     their numbers (meshio's ASCII .vtu keeps 12 digits); None where meshio cannot read it."""
     try:
-        with contextlib.redirect_stdout(io.StringIO()):  # meshio prints its failures
+        quiet = io.StringIO()  # meshio prints its failures
+        with contextlib.redirect_stdout(quiet), contextlib.redirect_stderr(quiet):
             m = meshio_read(path)
     except (Exception, SystemExit):  # noqa: BLE001 - fall back to the reference mesh
         return None
@@ -237,7 +239,7 @@ def read_with_gmsh(path, dim, points, cells, physical):
     index = {t: i for i, t in enumerate(tags)}
     types, _, nodes = gmsh.model.mesh.getElements(dim)
     simplex = [n for t, n in zip(types, nodes) if t in (2, 4)]
-    got = np.array([index[t] for t in np.concatenate(simplex)]).reshape(-1, dim + 1) if simplex else np.zeros((0, dim + 1))
+    got = np.array([index[t] for t in np.concatenate(simplex)] if simplex else [], dtype=int).reshape(-1, dim + 1)
     same_points(points, got_points)
     same_cells(points, cells, got_points, got.astype(int))
     if physical:
