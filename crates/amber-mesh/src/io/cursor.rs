@@ -45,7 +45,7 @@ impl Scalar {
     pub(super) fn from_vtk_legacy(name: &str) -> Option<Self> {
         Some(match name.to_ascii_lowercase().as_str() {
             "char" => Self::I8,
-            "unsigned_char" | "bit" => Self::U8,
+            "unsigned_char" => Self::U8,
             "short" => Self::I16,
             "unsigned_short" => Self::U16,
             "int" | "vtktypeint32" => Self::I32,
