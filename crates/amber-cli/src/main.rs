@@ -1,8 +1,9 @@
 //! The `amber` command line.
 //!
 //! `amber mesh` meshes a geometry with a trained model (or a given sizing field) into a mesh file
-//! or picture; `amber train` trains AMBER.
+//! or picture; `amber train` trains AMBER; `amber convert` converts between mesh file formats.
 
+mod convert;
 mod mesh;
 mod train;
 
@@ -21,6 +22,8 @@ enum Command {
     Mesh(mesh::MeshArgs),
     /// Train AMBER (resumes a killed run in the same --out directory).
     Train(train::TrainArgs),
+    /// Convert a mesh file: .msh, .vtu, .vtk, .nas, .inp, .mesh, .json in, any of them out.
+    Convert(convert::ConvertArgs),
 }
 
 #[global_allocator]
@@ -35,5 +38,6 @@ fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Mesh(args) => mesh::run(args),
         Command::Train(args) => train::train(args),
+        Command::Convert(args) => convert::run(args),
     }
 }

@@ -32,6 +32,42 @@ fn meshes_an_lshape_and_remeshes_from_the_result() {
 }
 
 #[test]
+fn converts_between_formats_in_the_dimension_of_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("square.json");
+    std::fs::write(
+        &json,
+        r#"{"dimension": 2, "vertices": [[0, 0], [1, 0], [1, 1], [0, 1]],
+        "elements": [[0, 1, 2], [0, 2, 3]], "cell_data": {"size": [0.5, 0.25]}}"#,
+    )
+    .unwrap();
+    let msh = dir.path().join("square.msh");
+    assert!(amber().arg("convert").arg(&json).arg(&msh).arg("--binary").status().unwrap().success());
+    assert!(std::fs::read(&msh).unwrap().windows(7).any(|w| w == b"4.1 1 8"), "binary .msh");
+    let vtk = dir.path().join("square.vtk");
+    let output = amber().arg("convert").arg(&msh).arg(&vtk).output().unwrap();
+    assert!(output.status.success());
+    assert!(String::from_utf8_lossy(&output.stderr).contains("4 line"), "the boundary lines are reported dropped");
+    let (mesh, data) = amber_mesh::read_mesh_with_data::<2>(&vtk).unwrap();
+    assert_eq!((mesh.num_elements(), data.cell["size"].clone()), (2, vec![0.5, 0.25]));
+
+    let bad = dir.path().join("bad.vtu");
+    std::fs::write(&bad, "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"x\"").unwrap();
+    for (input, output) in [(&bad, &vtk), (&json, &dir.path().join("x.ply")), (&json, &dir.path().join("x.inp"))] {
+        let mut command = amber();
+        command.arg("convert").arg(input).arg(output);
+        if output.ends_with("x.inp") {
+            command.arg("--binary");
+        }
+        let result = command.output().unwrap();
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert!(!result.status.success() && !stderr.contains("panicked"), "{stderr}");
+        let named = if input == &bad { "bad.vtu" } else { "x." };
+        assert!(stderr.contains(named), "{stderr}");
+    }
+}
+
+#[test]
 fn bad_input_fails_with_a_message_not_a_panic() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.vtu");

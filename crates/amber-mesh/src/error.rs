@@ -30,6 +30,9 @@ pub enum MeshError {
     /// A file was read but its content is malformed.
     #[error("{path}:{line}: {message}")]
     Parse { path: PathBuf, line: usize, message: String },
+    /// A binary part of a file is malformed at this byte offset.
+    #[error("{path}: byte {offset}: {message}")]
+    AtByte { path: PathBuf, offset: usize, message: String },
     /// A file's content is malformed or cannot be represented, where no line number applies.
     #[error("{path}: {message}")]
     Format { path: PathBuf, message: String },

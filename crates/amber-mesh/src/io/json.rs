@@ -74,7 +74,7 @@ pub(super) fn read<const D: usize>(path: &Path, bytes: &[u8]) -> Result<(Mesh<D>
         }
         cells.extend_from_slice(element);
     }
-    assemble(path, vertices, cells, MeshData { cell: json.cell_data, point: json.point_data })
+    assemble(path, vertices, cells, MeshData { cell: json.cell_data, point: json.point_data, ..MeshData::default() })
 }
 
 pub(super) fn write<const D: usize>(

@@ -1,35 +1,53 @@
 //! Reading and writing meshes, one entry point per direction, dispatching on the file extension:
-//! `.vtu` (VTK XML, binary), `.msh` (gmsh 4.1 ASCII), `.json`, and `.nas` (NASTRAN bulk data,
-//! read only); and reading triangle surfaces, `.stl` (binary or ASCII) and `.obj`, as the plain
+//! `.vtu` (VTK XML), `.vtk` (legacy VTK), `.msh` (gmsh 2.2 and 4.1), `.json`, `.nas` (NASTRAN
+//! bulk data), `.inp` (Abaqus) and `.mesh` (medit), in ASCII or binary wherever the format has
+//! both; and reading triangle surfaces, `.stl` (binary or ASCII) and `.obj`, as the plain
 //! triangles the file lists ([`TriangleSoup`]).
 //!
-//! Every mesh reader keeps only the simplices of the mesh dimension, drops vertices no kept
-//! element uses (a stray vertex would make an FEM system singular) and flips negatively oriented
-//! elements. Surfaces are read as they are: welding and checking them is the mesher's job. Every
-//! writer writes to a temporary file beside the target, fsyncs it and renames it (amber-stdx's
+//! Every mesh reader keeps only the linear simplices of the mesh dimension (and says in
+//! [`MeshData::dropped`] what else the file held), drops vertices no kept element uses (a stray
+//! vertex would make an FEM system singular) and flips negatively oriented elements. Surfaces
+//! are read as they are: welding and checking them is the mesher's job. Every writer writes to a
+//! temporary file beside the target, fsyncs it and renames it (amber-stdx's
 //! `write_atomic_with`), so a reader never sees a half-written file.
 
+mod abaqus;
+mod cursor;
 mod json;
+mod medit;
 mod msh;
 mod nastran;
 mod obj;
+mod raw;
 mod stl;
+mod vtk;
 mod vtu;
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::{Mesh, MeshError};
+use crate::{Mesh, Mesh2, Mesh3, MeshError};
 
-/// Named scalar fields on a mesh: one value per element (`cell`) or per vertex (`point`).
+/// What travels with a mesh in a file: named scalar fields with one value per element (`cell`)
+/// or per vertex (`point`), tags on boundary facets, and what a reader left out.
 ///
-/// `.vtu`, `.msh` and `.json` store them; `.nas` has none.
+/// `.vtu`, `.vtk`, `.msh` and `.json` store the fields; `.nas`, `.inp` and `.mesh` none. `.msh`
+/// and `.mesh` store the facet tags.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {
     /// Per-element fields, by name.
     pub cell: BTreeMap<String, Vec<f64>>,
     /// Per-vertex fields, by name.
     pub point: BTreeMap<String, Vec<f64>>,
+    /// Tags of facets (edges in 2D, triangles in 3D), keyed by their sorted vertex indices: CAD
+    /// face ids or boundary segment ids from the caller, or the physical groups (`.msh`) and
+    /// references (`.mesh`) of a file's lower-dimensional elements. The `.msh` writer makes one
+    /// physical group per tag (tags must be positive); without tags it writes one group for the
+    /// whole boundary.
+    pub facet_tags: BTreeMap<Vec<u32>, i32>,
+    /// Elements a reader dropped because they are not linear simplices of the mesh dimension,
+    /// counted by kind (`line`, `quad`, `triangle6`, ...). Writers ignore it.
+    pub dropped: BTreeMap<String, usize>,
 }
 
 impl MeshData {
@@ -50,9 +68,17 @@ impl MeshData {
         self
     }
 
-    /// Whether there are no fields at all.
+    /// Adds (or replaces) the tag of the facet with these vertices (in any order).
+    pub fn with_facet_tag(mut self, facet: impl Into<Vec<u32>>, tag: i32) -> Self {
+        let mut facet = facet.into();
+        facet.sort_unstable();
+        self.facet_tags.insert(facet, tag);
+        self
+    }
+
+    /// Whether there are no fields and no facet tags.
     pub fn is_empty(&self) -> bool {
-        self.cell.is_empty() && self.point.is_empty()
+        self.cell.is_empty() && self.point.is_empty() && self.facet_tags.is_empty()
     }
 
     /// Checks that every field has one value per element or vertex.
@@ -76,26 +102,42 @@ impl MeshData {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Format {
     Vtu,
+    Vtk,
     Msh,
     Json,
     Nastran,
+    Abaqus,
+    Medit,
 }
 
-const READ_FORMATS: &str = ".vtu, .msh, .json, .nas";
-const WRITE_FORMATS: &str = ".vtu, .msh, .json";
+const FORMATS: &str = ".vtu, .vtk, .msh, .json, .nas, .inp, .mesh";
 
 fn format_of(path: &Path) -> Option<Format> {
     let ext = path.extension()?.to_str()?.to_ascii_lowercase();
     match ext.as_str() {
         "vtu" => Some(Format::Vtu),
+        "vtk" => Some(Format::Vtk),
         "msh" => Some(Format::Msh),
         "json" => Some(Format::Json),
-        "nas" => Some(Format::Nastran),
+        "nas" | "bdf" => Some(Format::Nastran),
+        "inp" => Some(Format::Abaqus),
+        "mesh" => Some(Format::Medit),
         _ => None,
     }
 }
 
-/// Reads a mesh, choosing the format by extension (`.vtu`, `.msh`, `.json`, `.nas`).
+/// How a format that has both writes its numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Encoding {
+    /// Text.
+    Ascii,
+    /// Binary: `.msh` little-endian sections, `.vtu` inline base64, `.vtk` big-endian.
+    Binary,
+}
+
+/// Reads a mesh, choosing the format by extension (`.vtu`, `.vtk`, `.msh`, `.json`, `.nas`,
+/// `.inp`, `.mesh`). A file whose highest-dimensional elements are not `D`-dimensional is a
+/// [`MeshError::DimensionMismatch`], so a caller that does not know the dimension can try 3, then 2.
 ///
 /// ```no_run
 /// let mesh: amber_mesh::Mesh3 = amber_mesh::read_mesh("expert.nas")?;
@@ -105,18 +147,60 @@ pub fn read_mesh<const D: usize>(path: impl AsRef<Path>) -> Result<Mesh<D>, Mesh
     read_mesh_with_data(path).map(|(mesh, _)| mesh)
 }
 
-/// Reads a mesh and the scalar fields stored with it (none for `.nas`).
+/// Reads a mesh with the fields and facet tags stored with it, and what was dropped.
 pub fn read_mesh_with_data<const D: usize>(path: impl AsRef<Path>) -> Result<(Mesh<D>, MeshData), MeshError> {
     let path = path.as_ref();
-    let format = format_of(path)
-        .ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: READ_FORMATS })?;
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
-    match format {
-        Format::Vtu => vtu::read(path, &bytes),
-        Format::Msh => msh::read(path, &bytes),
-        Format::Json => json::read(path, &bytes),
-        Format::Nastran => nastran::read(path, &bytes),
+    match read_raw(path)? {
+        Parsed::Json(bytes) => json::read(path, &bytes),
+        Parsed::Raw(raw) => raw.finish(path),
     }
+}
+
+/// A mesh in the dimension its file holds, with its data.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyMesh {
+    Two(Mesh2, MeshData),
+    Three(Mesh3, MeshData),
+}
+
+/// Reads a mesh whose dimension is not known in advance: the highest dimension of the file's
+/// elements decides (3: tetrahedra, 2: triangles). The file is parsed once.
+pub fn read_any_mesh(path: impl AsRef<Path>) -> Result<AnyMesh, MeshError> {
+    let path = path.as_ref();
+    match read_raw(path)? {
+        Parsed::Json(bytes) => match json::read::<3>(path, &bytes) {
+            Err(MeshError::DimensionMismatch { found: 2, .. }) => {
+                json::read(path, &bytes).map(|(mesh, data)| AnyMesh::Two(mesh, data))
+            }
+            read => read.map(|(mesh, data)| AnyMesh::Three(mesh, data)),
+        },
+        Parsed::Raw(raw) => match raw.dimension() {
+            2 => raw.finish(path).map(|(mesh, data)| AnyMesh::Two(mesh, data)),
+            // Anything else is a DimensionMismatch from `finish`, naming what the file holds.
+            _ => raw.finish(path).map(|(mesh, data)| AnyMesh::Three(mesh, data)),
+        },
+    }
+}
+
+/// A file parsed up to the point where the mesh dimension matters.
+enum Parsed {
+    Json(Vec<u8>),
+    Raw(raw::RawMesh),
+}
+
+fn read_raw(path: &Path) -> Result<Parsed, MeshError> {
+    let format =
+        format_of(path).ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: FORMATS })?;
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
+    Ok(Parsed::Raw(match format {
+        Format::Json => return Ok(Parsed::Json(bytes)),
+        Format::Vtu => vtu::read(path, &bytes)?,
+        Format::Vtk => vtk::read(path, &bytes)?,
+        Format::Msh => msh::read(path, &bytes)?,
+        Format::Nastran => nastran::read(path, &bytes)?,
+        Format::Abaqus => abaqus::read(path, &bytes)?,
+        Format::Medit => medit::read(path, &bytes)?,
+    }))
 }
 
 /// Where the face ids of an STL file come from.
@@ -175,8 +259,9 @@ fn parse_point<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<[f64; 3],
     Ok(p)
 }
 
-/// Writes a mesh with optional scalar fields, choosing the format by extension (`.vtu`, `.msh`,
-/// `.json`). The file appears atomically: it is written beside `path` and renamed.
+/// Writes a mesh with optional scalar fields, choosing the format by extension (`.vtu`, `.vtk`,
+/// `.msh`, `.json`, `.nas`, `.inp`, `.mesh`) in its default encoding: binary `.vtu`, ASCII for
+/// the rest. The file appears atomically: it is written beside `path` and renamed.
 ///
 /// ```no_run
 /// # let mesh = amber_mesh::Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2])?;
@@ -185,16 +270,89 @@ fn parse_point<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<[f64; 3],
 /// # Ok::<(), amber_mesh::MeshError>(())
 /// ```
 pub fn write_mesh<const D: usize>(mesh: &Mesh<D>, path: impl AsRef<Path>, data: &MeshData) -> Result<(), MeshError> {
+    write_mesh_as(mesh, path, data, None)
+}
+
+/// [`write_mesh`] in a chosen encoding (`None`: the format's default). `.msh`, `.vtu` and
+/// `.vtk` have both; asking a text-only format for binary is an error.
+///
+/// ```no_run
+/// # let mesh = amber_mesh::Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2])?;
+/// // Edges 0-1 and 1-2 in physical group 3, edge 2-0 in group 4.
+/// let data = amber_mesh::MeshData::new().with_facet_tag([0, 1], 3).with_facet_tag([1, 2], 3).with_facet_tag([2, 0], 4);
+/// amber_mesh::write_mesh_as(&mesh, "solver.msh", &data, Some(amber_mesh::Encoding::Binary))?;
+/// # Ok::<(), amber_mesh::MeshError>(())
+/// ```
+pub fn write_mesh_as<const D: usize>(
+    mesh: &Mesh<D>,
+    path: impl AsRef<Path>,
+    data: &MeshData,
+    encoding: Option<Encoding>,
+) -> Result<(), MeshError> {
     let path = path.as_ref();
-    let unsupported = || MeshError::UnsupportedFormat { path: path.to_owned(), expected: WRITE_FORMATS };
-    let format = format_of(path).ok_or_else(unsupported)?;
+    let format =
+        format_of(path).ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: FORMATS })?;
     data.check_lengths(path, mesh.num_elements(), mesh.num_vertices())?;
-    match format {
-        Format::Vtu => write_atomic(path, |w| vtu::write(mesh, data, w, path)),
-        Format::Msh => write_atomic(path, |w| msh::write(mesh, data, w, path)),
-        Format::Json => write_atomic(path, |w| json::write(mesh, data, w, path)),
-        Format::Nastran => Err(unsupported()),
+    let binary = match (format, encoding) {
+        (Format::Vtu, None) | (_, Some(Encoding::Binary)) => true,
+        (_, None | Some(Encoding::Ascii)) => false,
+    };
+    if binary && !matches!(format, Format::Vtu | Format::Vtk | Format::Msh) {
+        let message = "this format has no binary encoding".to_owned();
+        return Err(MeshError::Format { path: path.to_owned(), message });
     }
+    match format {
+        Format::Vtu => write_atomic(path, |w| vtu::write(mesh, data, binary, w).map_err(write_error(path))),
+        Format::Vtk => write_atomic(path, |w| vtk::write(mesh, data, binary, w, path)),
+        Format::Msh => write_atomic(path, |w| msh::write(mesh, data, binary, w, path)),
+        Format::Json => write_atomic(path, |w| json::write(mesh, data, w, path)),
+        Format::Nastran => write_atomic(path, |w| nastran::write(mesh, w).map_err(write_error(path))),
+        Format::Abaqus => write_atomic(path, |w| abaqus::write(mesh, w).map_err(write_error(path))),
+        Format::Medit => write_atomic(path, |w| medit::write(mesh, data, w, path)),
+    }
+}
+
+/// The boundary facets of a mesh, outward oriented (counter-clockwise around the element in 2D,
+/// normal pointing out of it in 3D), each with the vertex list a facet tag is keyed by.
+fn boundary_facets<const D: usize>(mesh: &Mesh<D>) -> Result<Vec<Vec<u32>>, MeshError> {
+    const OUTWARD_2: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
+    const OUTWARD_3: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+    let adjacency = crate::FacetAdjacency::new(mesh)?;
+    Ok(adjacency
+        .boundary_facets()
+        .map(|(e, local)| {
+            let cell = mesh.element(e);
+            let corners: &[usize] = if D == 2 { &OUTWARD_2[local] } else { &OUTWARD_3[local] };
+            corners.iter().map(|&k| cell[k]).collect()
+        })
+        .collect())
+}
+
+/// The facets a writer stores with their tags: every tagged facet, and the untagged boundary
+/// facets with `untagged` (one past the largest tag, or 1 when nothing is tagged).
+fn tagged_facets<const D: usize>(
+    mesh: &Mesh<D>,
+    data: &MeshData,
+    path: &Path,
+) -> Result<Vec<(Vec<u32>, i32)>, MeshError> {
+    if let Some(facet) =
+        data.facet_tags.keys().find(|k| k.len() != D || k.iter().any(|&v| v as usize >= mesh.num_vertices()))
+    {
+        let message = format!("facet tag on {facet:?}, which is not {D} vertices of the mesh");
+        return Err(MeshError::Format { path: path.to_owned(), message });
+    }
+    let untagged = data.facet_tags.values().max().map_or(1, |&t| t.saturating_add(1));
+    let mut facets: Vec<(Vec<u32>, i32)> = Vec::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for facet in boundary_facets(mesh)? {
+        let mut key = facet.clone();
+        key.sort_unstable();
+        facets.push((facet, data.facet_tags.get(&key).copied().unwrap_or(untagged)));
+        seen.insert(key);
+    }
+    facets.extend(data.facet_tags.iter().filter(|(k, _)| !seen.contains(*k)).map(|(k, &t)| (k.clone(), t)));
+    facets.sort_by_key(|&(_, t)| t);
+    Ok(facets)
 }
 
 /// Every file this crate writes goes through amber-stdx's atomic writer (temporary file,
@@ -229,12 +387,22 @@ fn assemble<const D: usize>(
         }
     }
     let kept: Vec<usize> = (0..vertices.len()).filter(|&v| new_index[v] == 0).collect();
+    for (new, &old) in kept.iter().enumerate() {
+        new_index[old] = new as u32;
+    }
+    // Facets on vertices no element uses (or outside the file's points) go with them.
+    let renumber = |v: &u32| new_index.get(*v as usize).copied().filter(|&i| i != u32::MAX);
+    data.facet_tags = std::mem::take(&mut data.facet_tags)
+        .into_iter()
+        .filter_map(|(facet, tag)| {
+            let mut facet = facet.iter().map(renumber).collect::<Option<Vec<u32>>>()?;
+            facet.sort_unstable();
+            Some((facet, tag))
+        })
+        .collect();
     let (vertices, cells) = if kept.len() == vertices.len() {
         (vertices, cells)
     } else {
-        for (new, &old) in kept.iter().enumerate() {
-            new_index[old] = new as u32;
-        }
         for values in data.point.values_mut() {
             *values = kept.iter().map(|&old| values[old]).collect();
         }
@@ -315,6 +483,8 @@ mod tests {
         Mesh3::new(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3]).unwrap()
     }
 
+    /// Every writer through the matching reader, in every encoding: the same mesh bit for bit,
+    /// the fields where the format stores them, the boundary as facet tags where it has them.
     #[test]
     fn every_writable_format_round_trips_mesh_and_data() {
         let dir = test_dir("round-trip");
@@ -322,13 +492,32 @@ mod tests {
         let d2 = MeshData::new().with_cell("h", m2.sizes()).with_point("u", vec![0.0, 0.5, 1.0, 0.1 + 0.2]);
         let m3 = tet();
         let d3 = MeshData::new().with_cell("h", m3.sizes());
-        for ext in ["vtu", "msh", "json", "VTU"] {
-            let p2 = dir.join(format!("m2.{ext}"));
-            write_mesh(&m2, &p2, &d2).unwrap();
-            assert_eq!(read_mesh_with_data::<2>(&p2).unwrap(), (m2.clone(), d2.clone()), "{ext}");
-            let p3 = dir.join(format!("m3.{ext}"));
-            write_mesh(&m3, &p3, &d3).unwrap();
-            assert_eq!(read_mesh_with_data::<3>(&p3).unwrap(), (m3.clone(), d3.clone()), "{ext}");
+        let encodings = [None, Some(Encoding::Ascii), Some(Encoding::Binary)];
+        for ext in ["vtu", "vtk", "msh", "json", "nas", "inp", "mesh", "VTU"] {
+            for encoding in encodings {
+                let p2 = dir.join(format!("m2.{ext}"));
+                let written = write_mesh_as(&m2, &p2, &d2, encoding);
+                if encoding == Some(Encoding::Binary) && !matches!(ext, "vtu" | "vtk" | "msh" | "VTU") {
+                    assert!(written.unwrap_err().to_string().contains("no binary encoding"), "{ext}");
+                    continue;
+                }
+                written.unwrap();
+                let (back, data) = read_mesh_with_data::<2>(&p2).unwrap();
+                assert_eq!(back, m2, "{ext} {encoding:?}");
+                let has_fields = matches!(ext, "vtu" | "vtk" | "msh" | "json" | "VTU");
+                assert_eq!(
+                    (data.cell, data.point),
+                    if has_fields { (d2.cell.clone(), d2.point.clone()) } else { Default::default() }
+                );
+                let boundary_edges = if matches!(ext, "msh" | "mesh") { 4 } else { 0 };
+                assert_eq!(data.facet_tags.len(), boundary_edges, "{ext}");
+                let p3 = dir.join(format!("m3.{ext}"));
+                write_mesh_as(&m3, &p3, &d3, encoding).unwrap();
+                let (back, data) = read_mesh_with_data::<3>(&p3).unwrap();
+                assert_eq!(back, m3, "{ext} {encoding:?}");
+                assert_eq!(data.cell, if has_fields { d3.cell.clone() } else { Default::default() });
+                assert!(matches!(read_mesh::<2>(&p3), Err(MeshError::DimensionMismatch { found: 3, .. })), "{ext}");
+            }
         }
         let leftovers: Vec<_> =
             std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
@@ -337,13 +526,11 @@ mod tests {
     }
 
     #[test]
-    fn unknown_extensions_and_nastran_writes_are_unsupported() {
+    fn unknown_extensions_are_unsupported() {
         let dir = test_dir("unsupported");
         let err = write_mesh(&square(), dir.join("m.stl"), &MeshData::new()).unwrap_err();
         assert!(matches!(err, MeshError::UnsupportedFormat { .. }), "{err}");
         assert!(err.to_string().contains("m.stl"));
-        let err = write_mesh(&tet(), dir.join("m.nas"), &MeshData::new()).unwrap_err();
-        assert!(matches!(err, MeshError::UnsupportedFormat { .. }), "{err}");
         assert!(matches!(read_mesh::<2>(dir.join("m")), Err(MeshError::UnsupportedFormat { .. })));
         assert!(matches!(read_mesh::<2>(dir.join("missing.vtu")), Err(MeshError::Io { .. })));
         std::fs::remove_dir_all(dir).unwrap();

@@ -1,300 +1,474 @@
-//! gmsh `.msh` 4.1 ASCII. The reader accepts what gmsh writes: entity blocks, non-contiguous
-//! node tags, elements of every dimension (only the simplices of the mesh dimension are kept),
-//! sections it does not know (skipped), and scalar `$NodeData` / `$ElementData`. The writer puts
-//! the whole mesh into one entity without `$Entities`, which gmsh accepts.
+//! gmsh `.msh`, versions 2.2 and 4.1, ASCII and binary (little-endian, 8-byte `size_t`).
+//!
+//! The reader is our own rather than the `mshio` crate's: mshio reads 4.1 only, skips
+//! `$ElementData` and `$PhysicalNames`, and panics on some inputs. It accepts what gmsh and
+//! meshio write: entity blocks with physical groups (a lower-dimensional simplex in a physical
+//! group becomes a facet tag), non-contiguous node tags, elements of every type (the raw mesh
+//! keeps them all; [`RawMesh::finish`] picks), sections it does not know (skipped), and scalar
+//! `$NodeData` / `$ElementData` (other component counts are skipped; a value missing for an
+//! element or node is NaN).
+//!
+//! The writer writes 4.1 with `$Entities` and `$PhysicalNames`: the domain in physical group 1
+//! `domain`, the boundary facets (and any other tagged facet) in one physical group per tag, each
+//! in an entity of its own, and the fields as `$NodeData` / `$ElementData` (NaN on the facets).
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io::Write;
 use std::path::Path;
 
-use super::{Lines, MeshData, assemble, write_error};
+use super::cursor::{Cursor, Scalar};
+use super::raw::{Kind, RawMesh};
+use super::{MeshData, tagged_facets, write_error};
 use crate::{Mesh, MeshError};
 
-/// gmsh element type numbers of the linear simplices.
-const TRIANGLE: u32 = 2;
-const TETRAHEDRON: u32 = 4;
-
-fn simplex_type(dim: usize) -> u32 {
-    if dim == 2 { TRIANGLE } else { TETRAHEDRON }
+/// The kind and node count of a gmsh element type.
+fn element_type(t: i64) -> Option<(Kind, usize)> {
+    let other = |dim, name| Kind { dim, name };
+    Some(match t {
+        1 => (Kind::LINE, 2),
+        2 => (Kind::TRIANGLE, 3),
+        3 => (other(2, "quad"), 4),
+        4 => (Kind::TETRA, 4),
+        5 => (other(3, "hexahedron"), 8),
+        6 => (other(3, "wedge"), 6),
+        7 => (other(3, "pyramid"), 5),
+        8 => (other(1, "line3"), 3),
+        9 => (other(2, "triangle6"), 6),
+        10 => (other(2, "quad9"), 9),
+        11 => (other(3, "tetra10"), 10),
+        12 => (other(3, "hexahedron27"), 27),
+        13 => (other(3, "wedge18"), 18),
+        14 => (other(3, "pyramid14"), 14),
+        15 => (Kind::VERTEX, 1),
+        16 => (other(2, "quad8"), 8),
+        17 => (other(3, "hexahedron20"), 20),
+        18 => (other(3, "wedge15"), 15),
+        19 => (other(3, "pyramid13"), 13),
+        20 => (other(2, "triangle9"), 9),
+        21 => (other(2, "triangle10"), 10),
+        26 => (other(1, "line4"), 4),
+        29 => (other(3, "tetra20"), 20),
+        _ => return None,
+    })
 }
 
-/// One `$NodeData` / `$ElementData` section, resolved to mesh indices once the whole file is read.
+/// The gmsh type of the linear simplex of dimension `dim` (1 to 3).
+fn simplex_type(dim: usize) -> i32 {
+    [15, 1, 2, 4][dim]
+}
+
+/// The numbers of a section body: words in an ASCII file, `int` / `size_t` / `double` in a
+/// binary one.
+struct Body<'a> {
+    c: Cursor<'a>,
+    binary: bool,
+}
+
+impl Body<'_> {
+    fn int(&mut self, what: &str) -> Result<i64, MeshError> {
+        if self.binary { Ok(self.c.value(Scalar::I32, what)? as i64) } else { self.c.parse(what) }
+    }
+
+    fn size(&mut self, what: &str) -> Result<u64, MeshError> {
+        if self.binary { Ok(self.c.value(Scalar::U64, what)? as u64) } else { self.c.parse(what) }
+    }
+
+    /// A coordinate, which must be finite.
+    fn real(&mut self, what: &str) -> Result<f64, MeshError> {
+        if self.binary { self.c.value(Scalar::F64, what) } else { self.c.real(what) }
+    }
+
+    /// A data value, which may be NaN or infinite.
+    fn value(&mut self, what: &str) -> Result<f64, MeshError> {
+        if self.binary { self.c.value(Scalar::F64, what) } else { self.c.parse(what) }
+    }
+
+    /// A count of items of at least `ascii_bytes` / `binary_bytes` each, bounded by the file.
+    fn count(&mut self, n: u64, ascii_bytes: usize, binary_bytes: usize, what: &str) -> Result<usize, MeshError> {
+        self.c.bound(n, if self.binary { binary_bytes } else { ascii_bytes }, what)
+    }
+
+    /// Consumes `$End{name}`.
+    fn end(&mut self, name: &str) -> Result<(), MeshError> {
+        let end = format!("$End{name}");
+        match self.c.word()? {
+            Some(word) if word == end => Ok(()),
+            Some(word) => Err(self.c.error(format!("expected {end}, found `{word}`"))),
+            None => Err(self.c.error(format!("unexpected end of file, expected {end}"))),
+        }
+    }
+}
+
+/// Tag → index: a vector when the tags are dense (gmsh numbers 1..n), else a hash map; a
+/// million-element file resolves its three million node references several times faster so.
+enum TagIndex {
+    Dense(Vec<u32>),
+    Sparse(HashMap<u64, u32>),
+}
+
+impl TagIndex {
+    /// Fails with the first tag given twice.
+    fn new(tags: &[u64]) -> Result<Self, u64> {
+        let max = tags.iter().copied().max().unwrap_or(0);
+        if max <= 2 * tags.len() as u64 + 16 {
+            let mut index = vec![u32::MAX; max as usize + 1];
+            for (i, &tag) in tags.iter().enumerate() {
+                if std::mem::replace(&mut index[tag as usize], i as u32) != u32::MAX {
+                    return Err(tag);
+                }
+            }
+            return Ok(TagIndex::Dense(index));
+        }
+        let mut index = HashMap::with_capacity(tags.len());
+        for (i, &tag) in tags.iter().enumerate() {
+            if index.insert(tag, i as u32).is_some() {
+                return Err(tag);
+            }
+        }
+        Ok(TagIndex::Sparse(index))
+    }
+
+    /// The same, the last of repeated tags winning.
+    fn last_wins(tags: &[u64]) -> Self {
+        TagIndex::Sparse(tags.iter().enumerate().map(|(i, &t)| (t, i as u32)).collect())
+    }
+
+    fn get(&self, tag: u64) -> Option<u32> {
+        match self {
+            TagIndex::Dense(index) => index.get(tag as usize).copied().filter(|&i| i != u32::MAX),
+            TagIndex::Sparse(index) => index.get(&tag).copied(),
+        }
+    }
+}
+
+/// A `$NodeData` / `$ElementData` section with the tags it gives values for.
 struct DataSection {
     on_elements: bool,
     name: String,
-    values: Vec<(u64, f64)>,
-    /// Line of the section's end, for errors found while resolving it.
-    line: usize,
+    values: Vec<(i64, f64)>,
 }
 
-pub(super) fn read<const D: usize>(path: &Path, bytes: &[u8]) -> Result<(Mesh<D>, MeshData), MeshError> {
-    let mut lines = Lines::new(path, bytes);
-    let mut seen_format = false;
-    let mut nodes = Nodes { index: HashMap::new(), tags: Vec::new(), vertices: Vec::new(), off_plane: None };
-    // Kept elements as node tags, resolved once all nodes are known.
-    let mut element_nodes: Vec<u64> = Vec::new();
+/// Parses a whole `.msh` file into a raw mesh.
+pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
+    let mut body = Body { c: Cursor::new(path, bytes), binary: false };
+    let mut version = None;
+    let mut raw = RawMesh::default();
+    let mut node_tags: Vec<u64> = Vec::new();
     let mut element_tags: Vec<u64> = Vec::new();
-    let mut max_dim = 0;
+    // Element nodes as node tags, resolved once every node is known.
+    let mut element_nodes: Vec<u64> = Vec::new();
+    let mut entity_physical: HashMap<(i64, i64), i32> = HashMap::new();
     let mut sections = Vec::new();
-    while let Some(line) = lines.next()? {
-        let header = line.trim();
-        if header.is_empty() {
-            continue;
-        }
-        let Some(name) = header.strip_prefix('$') else {
-            return Err(lines.error(format!("expected a section header, found `{header}`")));
+    while let Some(word) = body.c.word()? {
+        let Some(name) = word.strip_prefix('$') else {
+            return Err(body.c.error(format!("expected a section header, found `{word}`")));
         };
-        if !seen_format && name != "MeshFormat" {
-            return Err(lines.error("not a gmsh file: it must start with $MeshFormat"));
+        if version.is_none() && name != "MeshFormat" {
+            return Err(body.c.error("not a gmsh file: it must start with $MeshFormat"));
         }
+        body.c.skip_line();
         match name {
             "MeshFormat" => {
-                read_format(&mut lines)?;
-                seen_format = true;
-            }
-            "Nodes" => read_nodes(&mut lines, &mut nodes)?,
-            "Elements" => max_dim = max_dim.max(read_elements::<D>(&mut lines, &mut element_nodes, &mut element_tags)?),
-            "NodeData" | "ElementData" => sections.extend(read_data(&mut lines, name == "ElementData")?),
-            _ => loop {
-                if lines.expect(&format!("$End{name}"))?.trim() == format!("$End{name}") {
-                    break;
+                let v = body.c.expect_word("the format version")?;
+                if !matches!(v, "4.1" | "2.2") {
+                    return Err(body.c.error(format!("gmsh format version {v} is not supported, only 2.2 and 4.1")));
                 }
-            },
+                body.binary = body.c.parse::<u8>("the file type")? == 1;
+                if body.c.parse::<u8>("the data size")? != 8 {
+                    return Err(body.c.error("the data size must be 8 (bytes in a size_t)"));
+                }
+                body.c.skip_line();
+                if body.binary && body.int("the endianness check")? != 1 {
+                    return Err(body.c.byte_error("big-endian binary .msh files are not supported"));
+                }
+                version = Some(v == "4.1");
+                body.end(name)?;
+            }
+            "Entities" if version == Some(true) => read_entities(&mut body, &mut entity_physical)?,
+            "Nodes" => read_nodes(&mut body, version == Some(true), &mut raw.points, &mut node_tags)?,
+            "Elements" => read_elements(
+                &mut body,
+                version == Some(true),
+                &entity_physical,
+                &mut raw,
+                &mut element_tags,
+                &mut element_nodes,
+            )?,
+            "NodeData" | "ElementData" => sections.extend(read_data(&mut body, name == "ElementData")?),
+            _ => {
+                let end = format!("$End{name}");
+                let skip = body.c.rest().windows(end.len()).position(|w| w == end.as_bytes());
+                let skip = skip.ok_or_else(|| body.c.error(format!("no $End{name} after ${name}")))?;
+                body.c.take(skip, "the skipped section")?;
+                body.end(name)?;
+            }
         }
     }
-    if !seen_format {
-        return Err(lines.error("empty file"));
+    if version.is_none() {
+        return Err(body.c.error("empty file"));
     }
-    if max_dim != D {
-        return Err(MeshError::DimensionMismatch { path: path.to_owned(), expected: D, found: max_dim });
-    }
-    if let Some((line, z)) = nodes.off_plane {
-        let message = format!("z = {z} in a 2D mesh, which must lie in the plane z = 0");
-        return Err(MeshError::Parse { path: path.to_owned(), line, message });
-    }
-    let cells = element_nodes
+    let node_index = TagIndex::new(&node_tags)
+        .map_err(|tag| MeshError::Format { path: path.to_owned(), message: format!("node {tag} is defined twice") })?;
+    raw.nodes = element_nodes
         .iter()
-        .map(|tag| {
-            nodes.index.get(tag).copied().ok_or_else(|| MeshError::Format {
+        .map(|&tag| {
+            node_index.get(tag).ok_or_else(|| MeshError::Format {
                 path: path.to_owned(),
                 message: format!("an element references node {tag}, which $Nodes does not define"),
             })
         })
-        .collect::<Result<Vec<u32>, _>>()?;
-    let data = resolve_data(path, sections, &nodes, &element_tags)?;
-    assemble(path, nodes.vertices, cells, data)
-}
-
-/// The nodes read so far: coordinates, gmsh tags, and tag → index.
-struct Nodes<const D: usize> {
-    index: HashMap<u64, u32>,
-    tags: Vec<u64>,
-    vertices: Vec<[f64; D]>,
-    /// The first node off the plane z = 0 in 2D (line, z), reported only once the file is known
-    /// to hold a 2D mesh, so that a 3D file is reported as such.
-    off_plane: Option<(usize, f64)>,
-}
-
-/// Consumes the line `$End{name}` that must follow a section body.
-fn expect_end(lines: &mut Lines, name: &str) -> Result<(), MeshError> {
-    let end = format!("$End{name}");
-    let line = lines.expect(&end)?.trim();
-    if line != end {
-        return Err(lines.error(format!("expected {end}, found `{line}`")));
-    }
-    Ok(())
-}
-
-fn read_format(lines: &mut Lines) -> Result<(), MeshError> {
-    let line = lines.expect("the format line `4.1 0 8`")?;
-    let mut t = line.split_ascii_whitespace();
-    let version = t.next().ok_or_else(|| lines.error("missing format version"))?;
-    let file_type: u32 = lines.parse(t.next(), "file type")?;
-    if version != "4.1" {
-        return Err(lines.error(format!("gmsh format version {version} is not supported, only 4.1")));
-    }
-    if file_type != 0 {
-        return Err(lines.error("binary .msh files are not supported, only ASCII"));
-    }
-    expect_end(lines, "MeshFormat")
-}
-
-/// Reads a `$Nodes` body: `numEntityBlocks numNodes minTag maxTag`, then per block
-/// `entityDim entityTag parametric numNodesInBlock`, the block's tags, then its coordinates.
-fn read_nodes<const D: usize>(lines: &mut Lines, nodes: &mut Nodes<D>) -> Result<(), MeshError> {
-    let line = lines.expect("the $Nodes header")?;
-    let mut t = line.split_ascii_whitespace();
-    let blocks: usize = lines.parse(t.next(), "number of node blocks")?;
-    let total: usize = lines.parse(t.next(), "number of nodes")?;
-    let mut read = 0;
-    for _ in 0..blocks {
-        let line = lines.expect("a node block header")?;
-        let mut t = line.split_ascii_whitespace();
-        let _dim: usize = lines.parse(t.next(), "entity dimension")?;
-        let _entity: i64 = lines.parse(t.next(), "entity tag")?;
-        let _parametric: u8 = lines.parse(t.next(), "parametric flag")?;
-        let count: usize = lines.parse(t.next(), "number of nodes in block")?;
-        let first = nodes.vertices.len();
-        for _ in 0..count {
-            let line = lines.expect("a node tag")?;
-            let tag: u64 = lines.parse(line.split_ascii_whitespace().next(), "node tag")?;
-            if nodes.index.insert(tag, nodes.vertices.len() as u32).is_some() {
-                return Err(lines.error(format!("node {tag} is defined twice")));
-            }
-            nodes.tags.push(tag);
-            nodes.vertices.push([0.0; D]);
-        }
-        for vertex in &mut nodes.vertices[first..] {
-            let line = lines.expect("node coordinates")?;
-            let mut t = line.split_ascii_whitespace();
-            let xyz: [f64; 3] = [
-                finite(lines, t.next(), "x coordinate")?,
-                finite(lines, t.next(), "y coordinate")?,
-                finite(lines, t.next(), "z coordinate")?,
-            ];
-            if D == 2 && xyz[2] != 0.0 && nodes.off_plane.is_none() {
-                nodes.off_plane = Some((lines.line, xyz[2]));
-            }
-            *vertex = std::array::from_fn(|k| xyz[k]);
-        }
-        read += count;
-    }
-    if read != total {
-        return Err(lines.error(format!("the $Nodes header announces {total} nodes, the blocks hold {read}")));
-    }
-    expect_end(lines, "Nodes")
-}
-
-/// Reads an `$Elements` body, appending the node tags and element tags of the `D`-simplices.
-/// Returns the highest dimension of any element block.
-fn read_elements<const D: usize>(
-    lines: &mut Lines,
-    element_nodes: &mut Vec<u64>,
-    element_tags: &mut Vec<u64>,
-) -> Result<usize, MeshError> {
-    let line = lines.expect("the $Elements header")?;
-    let mut t = line.split_ascii_whitespace();
-    let blocks: usize = lines.parse(t.next(), "number of element blocks")?;
-    let total: usize = lines.parse(t.next(), "number of elements")?;
-    let mut read = 0;
-    let mut max_dim = 0;
-    for _ in 0..blocks {
-        let line = lines.expect("an element block header")?;
-        let mut t = line.split_ascii_whitespace();
-        let dim: usize = lines.parse(t.next(), "entity dimension")?;
-        let _entity: i64 = lines.parse(t.next(), "entity tag")?;
-        let element_type: u32 = lines.parse(t.next(), "element type")?;
-        let count: usize = lines.parse(t.next(), "number of elements in block")?;
-        max_dim = max_dim.max(dim);
-        let keep = dim == D;
-        if keep && element_type != simplex_type(D) {
-            return Err(lines.error(format!(
-                "element type {element_type} in a {D}D block: only linear {} are supported",
-                if D == 2 { "triangles (type 2)" } else { "tetrahedra (type 4)" }
-            )));
-        }
-        for _ in 0..count {
-            let line = lines.expect("an element")?;
-            if !keep {
-                continue;
-            }
-            let mut t = line.split_ascii_whitespace();
-            element_tags.push(lines.parse(t.next(), "element tag")?);
-            for _ in 0..=D {
-                element_nodes.push(lines.parse(t.next(), "node tag")?);
-            }
-            if t.next().is_some() {
-                return Err(lines.error(format!("too many nodes for a {D}D simplex")));
-            }
-        }
-        read += count;
-    }
-    if read != total {
-        return Err(lines.error(format!("the $Elements header announces {total} elements, the blocks hold {read}")));
-    }
-    expect_end(lines, "Elements")?;
-    Ok(max_dim)
-}
-
-fn finite(lines: &Lines, token: Option<&str>, what: &str) -> Result<f64, MeshError> {
-    let x: f64 = lines.parse(token, what)?;
-    if x.is_finite() { Ok(x) } else { Err(lines.error(format!("{what} is not finite"))) }
-}
-
-/// Reads a `$NodeData` / `$ElementData` section through its end line. Returns `None` for
-/// non-scalar fields, which are skipped.
-fn read_data(lines: &mut Lines, on_elements: bool) -> Result<Option<DataSection>, MeshError> {
-    let section = if on_elements { "ElementData" } else { "NodeData" };
-    let mut tags = |what: &str| -> Result<Vec<String>, MeshError> {
-        let count = lines.expect(&format!("number of {what} tags"))?;
-        let n: usize = lines.parse(Some(count.trim()), "tag count")?;
-        (0..n).map(|_| lines.expect(&format!("a {what} tag")).map(|s| s.trim().to_owned())).collect()
-    };
-    let strings = tags("string")?;
-    let _reals = tags("real")?;
-    let integers = tags("integer")?;
-    let integer =
-        |i: usize, what: &str| -> Result<usize, MeshError> { lines.parse(integers.get(i).map(String::as_str), what) };
-    let components = integer(1, "number of components")?;
-    let count = integer(2, "number of entities")?;
-    let name = strings.first().map(|s| s.trim_matches('"').to_owned()).unwrap_or_default();
-    let mut values = Vec::new();
-    for _ in 0..count {
-        let line = lines.expect("a data line")?;
-        let mut t = line.split_ascii_whitespace();
-        let tag: u64 = lines.parse(t.next(), "tag")?;
-        let value: f64 = lines.parse(t.next(), "value")?;
-        values.push((tag, value));
-    }
-    expect_end(lines, section)?;
-    Ok((components == 1).then_some(DataSection { on_elements, name, values, line: lines.line }))
-}
-
-/// Turns tag-indexed data sections into fields over the parsed vertices and kept elements.
-/// Values on dropped elements are ignored; every kept element and vertex needs a value.
-fn resolve_data<const D: usize>(
-    path: &Path,
-    sections: Vec<DataSection>,
-    nodes: &Nodes<D>,
-    element_tags: &[u64],
-) -> Result<MeshData, MeshError> {
-    let element_index: HashMap<u64, usize> = element_tags.iter().enumerate().map(|(i, &t)| (t, i)).collect();
-    let mut data = MeshData::new();
+        .collect::<Result<_, _>>()?;
+    // Element tags are unique within a file that gmsh reads; the last one wins otherwise.
+    let element_index = TagIndex::new(&element_tags).unwrap_or_else(|_| TagIndex::last_wins(&element_tags));
     for s in sections {
-        let (tags, kind) = if s.on_elements { (element_tags, "element") } else { (&nodes.tags[..], "node") };
-        let len = tags.len();
+        let (len, index) =
+            if s.on_elements { (element_tags.len(), &element_index) } else { (node_tags.len(), &node_index) };
         let mut field = vec![f64::NAN; len];
-        let mut filled = vec![false; len];
         for (tag, value) in s.values {
-            let index = if s.on_elements {
-                element_index.get(&tag).copied()
-            } else {
-                nodes.index.get(&tag).map(|&i| i as usize)
-            };
-            if let Some(i) = index {
-                field[i] = value;
-                filled[i] = true;
+            if let Some(i) = u64::try_from(tag).ok().and_then(|t| index.get(t)) {
+                field[i as usize] = value;
             }
-        }
-        if let Some(missing) = filled.iter().position(|&f| !f) {
-            return Err(MeshError::Parse {
-                path: path.to_owned(),
-                line: s.line,
-                message: format!("field `{}` has no value for {kind} {}", s.name, tags[missing]),
-            });
         }
         if s.on_elements {
-            data.cell.insert(s.name, field)
+            raw.cell_data.insert(s.name, field)
         } else {
-            data.point.insert(s.name, field)
+            raw.point_data.insert(s.name, field)
         };
     }
-    Ok(data)
+    Ok(raw)
+}
+
+/// Reads `$Entities` (4.1): the physical group (the first, if several) of every entity.
+fn read_entities(body: &mut Body, physical: &mut HashMap<(i64, i64), i32>) -> Result<(), MeshError> {
+    let mut counts = [0; 4];
+    for count in &mut counts {
+        *count = body.size("an entity count")?;
+    }
+    for (dim, &count) in counts.iter().enumerate() {
+        for _ in 0..body.count(count, 2, 4, "entities")? {
+            let tag = body.int("entity tag")?;
+            for _ in 0..if dim == 0 { 3 } else { 6 } {
+                body.value("entity bounding box")?;
+            }
+            let n = body.size("number of physical tags")?;
+            for k in 0..body.count(n, 2, 4, "physical tags")? {
+                let group = body.int("physical tag")?;
+                if k == 0 {
+                    physical.insert((dim as i64, tag), group as i32);
+                }
+            }
+            if dim > 0 {
+                let n = body.size("number of bounding entities")?;
+                for _ in 0..body.count(n, 2, 4, "bounding entities")? {
+                    body.int("bounding entity")?;
+                }
+            }
+        }
+    }
+    body.end("Entities")
+}
+
+fn read_nodes(body: &mut Body, v41: bool, points: &mut Vec<[f64; 3]>, tags: &mut Vec<u64>) -> Result<(), MeshError> {
+    let mut add = |tag: u64, p: [f64; 3]| {
+        tags.push(tag);
+        points.push(p);
+    };
+    if v41 {
+        let blocks = body.size("number of node blocks")?;
+        let total = body.size("number of nodes")?;
+        body.size("minimum node tag")?;
+        body.size("maximum node tag")?;
+        let mut read = 0u64;
+        for _ in 0..body.count(blocks, 8, 20, "node blocks")? {
+            body.int("entity dimension")?;
+            body.int("entity tag")?;
+            if body.int("parametric flag")? != 0 {
+                return Err(body.c.error("parametric nodes are not supported"));
+            }
+            let announced = body.size("number of nodes in block")?;
+            let count = body.count(announced, 8, 32, "nodes")?;
+            let block_tags = (0..count).map(|_| body.size("node tag")).collect::<Result<Vec<_>, _>>()?;
+            for tag in block_tags {
+                let p = [body.real("x coordinate")?, body.real("y coordinate")?, body.real("z coordinate")?];
+                add(tag, p);
+            }
+            read += announced;
+        }
+        if read != total {
+            return Err(body.c.error(format!("the $Nodes header announces {total} nodes, the blocks hold {read}")));
+        }
+    } else {
+        let announced = body.c.parse("number of nodes")?;
+        body.c.skip_line();
+        for _ in 0..body.count(announced, 8, 28, "nodes")? {
+            let tag = body.int("node tag")? as u64;
+            let p = [body.real("x coordinate")?, body.real("y coordinate")?, body.real("z coordinate")?];
+            add(tag, p);
+        }
+    }
+    body.end("Nodes")
+}
+
+fn read_elements(
+    body: &mut Body,
+    v41: bool,
+    entity_physical: &HashMap<(i64, i64), i32>,
+    raw: &mut RawMesh,
+    element_tags: &mut Vec<u64>,
+    element_nodes: &mut Vec<u64>,
+) -> Result<(), MeshError> {
+    let kind_of = |body: &Body, t: i64| {
+        element_type(t).ok_or_else(|| body.c.error(format!("element type {t} is not a gmsh type this reader knows")))
+    };
+    let mut push = |raw: &mut RawMesh, kind: Kind, tag: u64, physical: i32, nodes: &[u64]| {
+        raw.kinds.push(kind);
+        raw.tags.push(physical);
+        element_tags.push(tag);
+        element_nodes.extend_from_slice(nodes);
+        raw.ends.push(element_nodes.len());
+    };
+    let mut nodes = Vec::new();
+    if v41 {
+        let blocks = body.size("number of element blocks")?;
+        let total = body.size("number of elements")?;
+        body.size("minimum element tag")?;
+        body.size("maximum element tag")?;
+        let mut read = 0u64;
+        for _ in 0..body.count(blocks, 8, 20, "element blocks")? {
+            let dim = body.int("entity dimension")?;
+            let entity = body.int("entity tag")?;
+            let t = body.int("element type")?;
+            let (kind, n) = kind_of(body, t)?;
+            let physical = entity_physical.get(&(dim, entity)).copied().unwrap_or(0);
+            let announced = body.size("number of elements in block")?;
+            for _ in 0..body.count(announced, 2 * (n + 1), 8 * (n + 1), "elements")? {
+                let tag = body.size("element tag")?;
+                nodes.clear();
+                for _ in 0..n {
+                    nodes.push(body.size("node tag")?);
+                }
+                push(raw, kind, tag, physical, &nodes);
+            }
+            read += announced;
+        }
+        if read != total {
+            return Err(body
+                .c
+                .error(format!("the $Elements header announces {total} elements, the blocks hold {read}")));
+        }
+    } else {
+        let announced = body.c.parse("number of elements")?;
+        body.c.skip_line();
+        let total = body.count(announced, 8, 16, "elements")?;
+        let mut read = 0;
+        while read < total {
+            // ASCII: one element per line; binary: blocks of elements of one type.
+            let (t, count, num_tags) = if body.binary {
+                (body.int("element type")?, body.int("elements in block")?, body.int("number of tags")?)
+            } else {
+                (-1, 1, 0)
+            };
+            for _ in 0..count {
+                let tag = body.int("element tag")? as u64;
+                let (t, num_tags) = if body.binary { (t, num_tags) } else { (body.int("type")?, body.int("tags")?) };
+                let (kind, n) = kind_of(body, t)?;
+                let mut physical = 0;
+                for k in 0..num_tags {
+                    let value = body.int("element tag")?;
+                    if k == 0 {
+                        physical = value as i32;
+                    }
+                }
+                nodes.clear();
+                for _ in 0..n {
+                    nodes.push(body.int("node tag")? as u64);
+                }
+                push(raw, kind, tag, physical, &nodes);
+            }
+            read += usize::try_from(count).map_err(|_| body.c.error(format!("bad element count {count}")))?;
+        }
+    }
+    body.end("Elements")
+}
+
+/// Reads a `$NodeData` / `$ElementData` section; `None` for fields of more than one component.
+fn read_data(body: &mut Body, on_elements: bool) -> Result<Option<DataSection>, MeshError> {
+    let header = |body: &mut Body| -> Result<Vec<String>, MeshError> {
+        let n: usize = body.c.parse("number of tags")?;
+        body.c.skip_line();
+        let n = body.c.bound(n as u64, 2, "tags")?;
+        (0..n).map(|_| body.c.expect_line("a tag").map(|s| s.trim().to_owned())).collect()
+    };
+    let strings = header(body)?;
+    header(body)?;
+    let integers = header(body)?;
+    let integer = |i: usize, what: &str| -> Result<usize, MeshError> {
+        let word = integers.get(i).map(String::as_str).unwrap_or("");
+        word.parse().map_err(|_| body.c.error(format!("bad {what} `{word}`")))
+    };
+    let components = integer(1, "number of components")?;
+    let announced = integer(2, "number of entities")?;
+    let name = strings.first().map(|s| s.trim_matches('"').to_owned()).unwrap_or_default();
+    let count = body.count(announced as u64, 2 * (1 + components), 4 + 8 * components, "data values")?;
+    let mut values = Vec::with_capacity(count);
+    for _ in 0..count {
+        let tag = body.int("tag")?;
+        let value = body.value("value")?;
+        for _ in 1..components {
+            body.value("value")?;
+        }
+        values.push((tag, value));
+    }
+    body.end(if on_elements { "ElementData" } else { "NodeData" })?;
+    Ok((components == 1).then_some(DataSection { on_elements, name, values }))
+}
+
+/// The numbers of a section body as [`Body`] reads them: words separated by spaces with a line
+/// per record, or little-endian binary.
+struct Out<'w, W: Write> {
+    w: &'w mut W,
+    binary: bool,
+    first: bool,
+}
+
+impl<W: Write> Out<'_, W> {
+    fn word(&mut self, text: std::fmt::Arguments) -> std::io::Result<()> {
+        if !std::mem::take(&mut self.first) {
+            self.w.write_all(b" ")?;
+        }
+        self.w.write_fmt(text)
+    }
+
+    fn int(&mut self, v: i32) -> std::io::Result<()> {
+        if self.binary { self.w.write_all(&v.to_le_bytes()) } else { self.word(format_args!("{v}")) }
+    }
+
+    fn size(&mut self, v: usize) -> std::io::Result<()> {
+        if self.binary { self.w.write_all(&(v as u64).to_le_bytes()) } else { self.word(format_args!("{v}")) }
+    }
+
+    /// Shortest round-trip form in ASCII.
+    fn real(&mut self, v: f64) -> std::io::Result<()> {
+        if self.binary { self.w.write_all(&v.to_le_bytes()) } else { self.word(format_args!("{v:?}")) }
+    }
+
+    fn end_record(&mut self) -> std::io::Result<()> {
+        self.first = true;
+        if self.binary { Ok(()) } else { self.w.write_all(b"\n") }
+    }
+
+    /// The ASCII line `text` (section headers, names and data-section tags are text even in a
+    /// binary file).
+    fn line(&mut self, text: &str) -> std::io::Result<()> {
+        self.first = true;
+        writeln!(self.w, "{text}")
+    }
 }
 
 pub(super) fn write<const D: usize>(
     mesh: &Mesh<D>,
     data: &MeshData,
+    binary: bool,
     w: &mut impl Write,
     path: &Path,
 ) -> Result<(), MeshError> {
@@ -306,37 +480,149 @@ pub(super) fn write<const D: usize>(
             });
         }
     }
-    write_body(mesh, data, w).map_err(write_error(path))
+    let facets = tagged_facets(mesh, data, path)?;
+    if let Some((_, tag)) = facets.iter().find(|(_, t)| *t <= 0) {
+        let message = format!("facet tag {tag}: gmsh physical groups need positive tags");
+        return Err(MeshError::Format { path: path.to_owned(), message });
+    }
+    write_body(mesh, data, &facets, &mut Out { w, binary, first: true }).map_err(write_error(path))
 }
 
-/// Node and element tags are 1-based indices; coordinates use Rust's shortest round-trip form.
-fn write_body<const D: usize>(mesh: &Mesh<D>, data: &MeshData, w: &mut impl Write) -> std::io::Result<()> {
+/// Node tags are 1-based vertex indices, the domain elements come first (tags 1..=n, which the
+/// data sections refer to), then the facets group by group.
+fn write_body<const D: usize, W: Write>(
+    mesh: &Mesh<D>,
+    data: &MeshData,
+    facets: &[(Vec<u32>, i32)],
+    out: &mut Out<W>,
+) -> std::io::Result<()> {
     let (nv, ne) = (mesh.num_vertices(), mesh.num_elements());
-    writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
-    writeln!(w, "$Nodes\n1 {nv} 1 {nv}\n{D} 1 0 {nv}")?;
+    let mut groups: BTreeMap<i32, Vec<&[u32]>> = BTreeMap::new();
+    for (facet, tag) in facets {
+        groups.entry(*tag).or_default().push(facet);
+    }
+    out.line("$MeshFormat")?;
+    out.line(if out.binary { "4.1 1 8" } else { "4.1 0 8" })?;
+    if out.binary {
+        out.int(1)?;
+        out.line("")?;
+    }
+    out.line("$EndMeshFormat")?;
+
+    out.line("$PhysicalNames")?;
+    out.line(&format!("{}\n{D} 1 \"domain\"", groups.len() + 1))?;
+    for &tag in groups.keys() {
+        let name = if groups.len() == 1 { "boundary".to_owned() } else { format!("boundary_{tag}") };
+        out.line(&format!("{} {tag} \"{name}\"", D - 1))?;
+    }
+    out.line("$EndPhysicalNames")?;
+
+    // Entities: one per facet group (entity tag = 1, 2, ... in group order), one for the domain.
+    let (lo, hi) = mesh.bounding_box().unwrap_or(([0.0; D], [0.0; D]));
+    let corner = |p: [f64; D]| [p[0], p[1], if D == 3 { p[2] } else { 0.0 }];
+    let (lo, hi) = (corner(lo), corner(hi));
+    out.line("$Entities")?;
+    let mut counts = [0, 0, 0, 0];
+    counts[D - 1] = groups.len();
+    counts[D] = 1;
+    for c in counts {
+        out.size(c)?;
+    }
+    out.end_record()?;
+    let entity = |out: &mut Out<W>, tag: i32, physical: i32, bounding: &mut dyn Iterator<Item = i32>| {
+        out.int(tag)?;
+        for x in lo.iter().chain(&hi) {
+            out.real(*x)?;
+        }
+        out.size(1)?;
+        out.int(physical)?;
+        let bounding: Vec<i32> = bounding.collect();
+        out.size(bounding.len())?;
+        for b in bounding {
+            out.int(b)?;
+        }
+        out.end_record()
+    };
+    for (k, &tag) in groups.keys().enumerate() {
+        entity(out, k as i32 + 1, tag, &mut std::iter::empty())?;
+    }
+    entity(out, 1, 1, &mut (1..=groups.len() as i32))?;
+    if out.binary {
+        out.line("")?;
+    }
+    out.line("$EndEntities")?;
+
+    out.line("$Nodes")?;
+    for v in [1, nv, 1, nv] {
+        out.size(v)?;
+    }
+    out.end_record()?;
+    out.int(D as i32)?;
+    out.int(1)?;
+    out.int(0)?;
+    out.size(nv)?;
+    out.end_record()?;
     for tag in 1..=nv {
-        writeln!(w, "{tag}")?;
+        out.size(tag)?;
+        out.end_record()?;
     }
     for p in mesh.vertices() {
-        let z = if D == 3 { p[2] } else { 0.0 };
-        writeln!(w, "{:?} {:?} {:?}", p[0], p[1], z)?;
+        out.real(p[0])?;
+        out.real(p[1])?;
+        out.real(if D == 3 { p[2] } else { 0.0 })?;
+        out.end_record()?;
     }
-    writeln!(w, "$EndNodes\n$Elements\n1 {ne} 1 {ne}\n{D} 1 {} {ne}", simplex_type(D))?;
-    for (e, cell) in mesh.elements().enumerate() {
-        write!(w, "{}", e + 1)?;
-        for &v in cell {
-            write!(w, " {}", v + 1)?;
+    if out.binary {
+        out.line("")?;
+    }
+    out.line("$EndNodes")?;
+
+    let total = ne + facets.len();
+    out.line("$Elements")?;
+    for v in [groups.len() + 1, total, 1, total] {
+        out.size(v)?;
+    }
+    out.end_record()?;
+    let block = |out: &mut Out<W>, dim: usize, entity: i32, elements: &mut dyn Iterator<Item = &[u32]>, first_tag| {
+        let elements: Vec<&[u32]> = elements.collect();
+        out.int(dim as i32)?;
+        out.int(entity)?;
+        out.int(simplex_type(dim))?;
+        out.size(elements.len())?;
+        out.end_record()?;
+        for (k, nodes) in elements.iter().enumerate() {
+            out.size(first_tag + k)?;
+            for &v in *nodes {
+                out.size(v as usize + 1)?;
+            }
+            out.end_record()?;
         }
-        writeln!(w)?;
+        Ok::<usize, std::io::Error>(first_tag + elements.len())
+    };
+    let mut next_tag = block(out, D, 1, &mut mesh.elements(), 1)?;
+    for (k, members) in groups.values().enumerate() {
+        next_tag = block(out, D - 1, k as i32 + 1, &mut members.iter().copied(), next_tag)?;
     }
-    writeln!(w, "$EndElements")?;
+    if out.binary {
+        out.line("")?;
+    }
+    out.line("$EndElements")?;
+
     let sections = data.point.iter().map(|f| ("NodeData", f)).chain(data.cell.iter().map(|f| ("ElementData", f)));
     for (section, (name, values)) in sections {
-        writeln!(w, "${section}\n1\n\"{name}\"\n1\n0\n3\n0\n1\n{}", values.len())?;
-        for (i, v) in values.iter().enumerate() {
-            writeln!(w, "{} {v:?}", i + 1)?;
+        // Element fields give the facets NaN: meshio rejects a field that skips elements.
+        let padding = if section == "ElementData" { facets.len() } else { 0 };
+        let all = values.iter().copied().chain(std::iter::repeat_n(f64::NAN, padding));
+        out.line(&format!("${section}\n1\n\"{name}\"\n1\n0.0\n3\n0\n1\n{}", values.len() + padding))?;
+        for (i, v) in all.enumerate() {
+            out.int(i as i32 + 1)?;
+            out.real(v)?;
+            out.end_record()?;
         }
-        writeln!(w, "$End{section}")?;
+        if out.binary {
+            out.line("")?;
+        }
+        out.line(&format!("$End{section}"))?;
     }
     Ok(())
 }
@@ -347,15 +633,17 @@ mod tests {
     use crate::{Mesh2, Mesh3};
 
     fn parse<const D: usize>(text: &str) -> Result<(Mesh<D>, MeshData), MeshError> {
-        read(Path::new("inline.msh"), text.as_bytes())
+        let path = Path::new("inline.msh");
+        read(path, text.as_bytes())?.finish(path)
     }
 
     /// A unit square as gmsh 4.15 writes it (two triangles, clockwise as gmsh may list them),
-    /// with entities, boundary lines, corner points and non-contiguous node tags.
+    /// with entities, boundary lines in physical group 5, corner points and non-contiguous node
+    /// tags.
     const GMSH_2D: &str = "$MeshFormat\r\n4.1 0 8\r\n$EndMeshFormat\r\n\
 $PhysicalNames\r\n1\r\n2 1 \"domain\"\r\n$EndPhysicalNames\r\n\
 $Entities\r\n4 4 1 0\r\n1 0 0 0 0\r\n2 1 0 0 0\r\n3 1 1 0 0\r\n4 0 1 0 0\r\n\
-1 0 0 0 1 0 0 0 2 1 -2\r\n2 1 0 0 1 1 0 0 2 2 -3\r\n3 0 1 0 1 1 0 0 2 3 -4\r\n4 0 0 0 0 1 0 0 2 4 -1\r\n\
+1 0 0 0 1 0 0 1 5 2 1 -2\r\n2 1 0 0 1 1 0 0 2 2 -3\r\n3 0 1 0 1 1 0 0 2 3 -4\r\n4 0 0 0 0 1 0 0 2 4 -1\r\n\
 1 0 0 0 1 1 0 1 1 4 1 2 3 4\r\n$EndEntities\r\n\
 $Nodes\r\n2 4 10 40\r\n0 1 0 1\r\n10\r\n0 0 0\r\n2 1 0 3\r\n20\r\n30\r\n40\r\n1 0 0\r\n1 1 0\r\n0 1 0\r\n$EndNodes\r\n\
 $Elements\r\n3 5 1 9\r\n0 1 15 1\r\n1 10\r\n1 1 1 2\r\n2 10 20\r\n3 20 30\r\n2 1 2 2\r\n8 10 30 20\r\n9 10 40 30\r\n$EndElements\r\n";
@@ -366,8 +654,21 @@ $Elements\r\n3 5 1 9\r\n0 1 15 1\r\n1 10\r\n1 1 1 2\r\n2 10 20\r\n3 20 30\r\n2 1
         assert_eq!(mesh.num_vertices(), 4);
         assert_eq!(mesh.num_elements(), 2);
         assert!(mesh.volumes().iter().all(|&v| (v - 0.5).abs() < 1e-15));
-        assert!(data.is_empty());
+        assert_eq!(data.facet_tags, BTreeMap::from([(vec![0, 1], 5), (vec![1, 2], 5)]));
+        assert_eq!(data.dropped, BTreeMap::from([("line".into(), 2), ("vertex".into(), 1)]));
         assert!(matches!(parse::<3>(GMSH_2D), Err(MeshError::DimensionMismatch { expected: 3, found: 2, .. })));
+    }
+
+    #[test]
+    fn reads_version_2_2_with_physical_tags_and_data() {
+        let text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n\
+$Elements\n3\n1 2 2 7 1 1 2 3\n2 4 2 1 1 1 3 2 4\n3 15 0 4\n$EndElements\n\
+$ElementData\n1\n\"h\"\n1\n0.0\n3\n0\n1\n1\n2 0.25\n$EndElementData\n";
+        let (mesh, data) = parse::<3>(text).unwrap();
+        assert_eq!(mesh.num_elements(), 1);
+        assert!(mesh.volume(0) > 0.0, "the negative tetrahedron is flipped");
+        assert_eq!(data.cell["h"], vec![0.25]);
+        assert_eq!(data.facet_tags, BTreeMap::from([(vec![0, 1, 2], 7)]));
     }
 
     #[test]
@@ -378,32 +679,61 @@ $ElementData\n1\n\"h\"\n1\n0.0\n3\n0\n1\n2\n3 9.5\n7 0.25\n$EndElementData\n\
 $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
         let (mesh, data) = parse::<3>(text).unwrap();
         assert_eq!(mesh.num_elements(), 1);
-        assert!(mesh.volume(0) > 0.0, "the negative tetrahedron is flipped");
         assert_eq!(data.cell["h"], vec![0.25]);
         assert!(data.point.is_empty(), "vector fields are skipped");
+        assert!(data.facet_tags.is_empty(), "no physical groups");
         assert!(matches!(parse::<2>(text), Err(MeshError::DimensionMismatch { expected: 2, found: 3, .. })));
     }
 
-    #[test]
-    fn writer_round_trips_bit_exactly() {
-        let vertices = vec![[-0.0, 0.1, 0.2], [1.0 / 3.0, 0.1, 0.2], [0.0, 2f64.sqrt(), 0.2], [1e-7, 0.1, 0.3 + 0.6]];
-        let mesh = Mesh3::new_reoriented(vertices, vec![0, 1, 2, 3]).unwrap();
-        let data = MeshData::new().with_cell("h", vec![f64::NAN]).with_point("u", vec![5e-324, 1e300, -2.5, -0.0]);
+    fn written<const D: usize>(mesh: &Mesh<D>, data: &MeshData, binary: bool) -> Vec<u8> {
         let mut bytes = Vec::new();
-        write(&mesh, &data, &mut bytes, Path::new("x.msh")).unwrap();
-        let (back, back_data) = parse::<3>(std::str::from_utf8(&bytes).unwrap()).unwrap();
-        assert_eq!(back, mesh);
-        assert!(back_data.cell["h"][0].is_nan());
-        assert_eq!(back_data.point, data.point);
+        write(mesh, data, binary, &mut bytes, Path::new("x.msh")).unwrap();
+        bytes
     }
 
     #[test]
-    fn malformed_files_name_the_line() {
-        let cases: [(&str, usize, &str); 9] = [
+    fn writer_round_trips_bit_exactly_in_both_encodings() {
+        let vertices = vec![[-0.0, 0.1, 0.2], [1.0 / 3.0, 0.1, 0.2], [0.0, 2f64.sqrt(), 0.2], [1e-7, 0.1, 0.3 + 0.6]];
+        let mesh = Mesh3::new_reoriented(vertices, vec![0, 1, 2, 3]).unwrap();
+        let data = MeshData::new()
+            .with_cell("h", vec![f64::NAN])
+            .with_point("u", vec![5e-324, 1e300, -2.5, -0.0])
+            .with_facet_tag([0, 1, 2], 3);
+        for binary in [false, true] {
+            let bytes = written(&mesh, &data, binary);
+            let path = Path::new("x.msh");
+            let (back, back_data) = read(path, &bytes).unwrap().finish::<3>(path).unwrap();
+            assert_eq!(back, mesh);
+            assert!(back_data.cell["h"][0].is_nan());
+            assert_eq!(back_data.point, data.point);
+            // The three untagged boundary triangles get the next tag.
+            assert_eq!(back_data.facet_tags.len(), 4);
+            assert_eq!(back_data.facet_tags[&vec![0, 1, 2]], 3);
+            assert_eq!(back_data.facet_tags.values().filter(|&&t| t == 4).count(), 3);
+        }
+    }
+
+    #[test]
+    fn writes_one_boundary_group_by_default() {
+        let mesh = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2]).unwrap();
+        let text = String::from_utf8(written(&mesh, &MeshData::new(), false)).unwrap();
+        assert!(text.contains("$PhysicalNames\n2\n2 1 \"domain\"\n1 1 \"boundary\"\n"), "{text}");
+        assert!(text.contains("\n2 1 0 3\n") && text.contains("\n2 1 2 1\n1 1 2 3\n"), "{text}");
+        let (back, data) = parse::<2>(&text).unwrap();
+        assert_eq!(back, mesh);
+        assert_eq!(data.facet_tags.len(), 3);
+        let err = write(&mesh, &MeshData::new().with_facet_tag([0, 1], 0), false, &mut Vec::new(), Path::new("x.msh"));
+        assert!(err.unwrap_err().to_string().contains("positive"));
+        let err = write(&mesh, &MeshData::new().with_facet_tag([0, 7], 2), false, &mut Vec::new(), Path::new("x.msh"));
+        assert!(err.unwrap_err().to_string().contains("[0, 7]"));
+    }
+
+    #[test]
+    fn malformed_files_name_the_line_or_byte() {
+        let cases: [(&str, usize, &str); 7] = [
             ("", 0, "empty"),
             ("$Nodes\n", 1, "$MeshFormat"),
-            ("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", 2, "version 2.2"),
-            ("$MeshFormat\n4.1 1 8\n$EndMeshFormat\n", 2, "binary"),
+            ("$MeshFormat\n3.0 0 8\n$EndMeshFormat\n", 2, "version 3.0"),
             (
                 "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 3 1 3\n2 1 0 2\n1\n2\n0 0 0\n1 0 0\n$EndNodes\n",
                 10,
@@ -414,17 +744,11 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
                 8,
                 "bad y coordinate `x`",
             ),
+            ("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n2 1 0 2000000\n1\n", 6, "2000000 nodes announced"),
             (
-                "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 3 1 3\n2 1 0 3\n1\n2\n3\n0 0 0.5\n1 0 0\n0 1 0\n$EndNodes\n\
-$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n",
-                10,
-                "plane z = 0",
-            ),
-            ("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n2 1 0 2\n1\n", 8, "unexpected end of file"),
-            (
-                "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Elements\n1 1 1 1\n2 1 3 1\n1 1 2 3 4\n$EndElements\n",
+                "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Elements\n1 1 1 1\n2 1 99 1\n1 1 2 3 4\n$EndElements\n",
                 6,
-                "element type 3",
+                "element type 99",
             ),
         ];
         for (text, line, needle) in cases {
@@ -438,17 +762,23 @@ $Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n",
         let missing = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 1 1 1\n2 1 0 1\n1\n0 0 0\n$EndNodes\n\
 $Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n";
         assert!(parse::<2>(missing).unwrap_err().to_string().contains("node 2"));
-        let binary = b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n\xff\xfe\n";
-        assert!(read::<2>(Path::new("b.msh"), binary).unwrap_err().to_string().contains("b.msh:5"));
-    }
-
-    #[test]
-    fn writes_two_dimensional_meshes_in_the_plane() {
+        let twice = missing.replace("1 1 1 1\n2 1 0 1\n1\n0 0 0\n", "1 2 1 1\n2 1 0 2\n1\n1\n0 0 0\n1 0 0\n");
+        assert!(parse::<2>(&twice).unwrap_err().to_string().contains("node 1 is defined twice"));
+        let off_plane = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 3 1 3\n2 1 0 3\n1\n2\n3\n0 0 0.5\n1 0 0\n0 1 0\n\
+$EndNodes\n$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n";
+        assert!(parse::<2>(off_plane).unwrap_err().to_string().contains("plane z = 0"));
+        // Every truncation of a binary file is an error naming the file, never a panic.
         let mesh = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2]).unwrap();
-        let mut bytes = Vec::new();
-        write(&mesh, &MeshData::new(), &mut bytes, Path::new("x.msh")).unwrap();
-        let text = String::from_utf8(bytes).unwrap();
-        assert!(text.contains("\n2 1 0 3\n") && text.contains("\n2 1 2 1\n1 1 2 3\n"), "{text}");
-        assert_eq!(parse::<2>(&text).unwrap().0, mesh);
+        let bytes = written(&mesh, &MeshData::new().with_cell("h", vec![1.0]), true);
+        // A cut between sections leaves a shorter valid file; any other cut is an error.
+        let path = Path::new("cut.msh");
+        for cut in 0..bytes.len() - 1 {
+            if let Err(err) = read(path, &bytes[..cut]).and_then(|raw| raw.finish::<2>(path)) {
+                assert!(err.to_string().starts_with("cut.msh"), "{err}");
+            }
+        }
+        let in_nodes = bytes.windows(7).position(|w| w == b"$Nodes\n").unwrap() + 100;
+        let err = read(path, &bytes[..in_nodes]).err().unwrap();
+        assert!(err.to_string().contains("3 nodes announced, but only 41 bytes are left"), "{err}");
     }
 }

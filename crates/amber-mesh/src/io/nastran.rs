@@ -1,111 +1,154 @@
-//! NASTRAN bulk data (`.nas`) → tetrahedral mesh: GRID points and 4-node CTETRA elements, in
-//! small fixed-field (8 characters) or free-field (comma-separated) form. Surface elements
-//! (CTRIA3) and every other card are skipped; reading stops at ENDDATA, which must be there: a
-//! file without it is truncated, and a partial mesh is never returned. Reals may use NASTRAN's
-//! implicit exponent (`-7.11-15` = -7.11e-15). GRID ids may have gaps.
+//! NASTRAN bulk data (`.nas`, `.bdf`): GRID points (small fixed-field, free-field, and
+//! large-field `GRID*` with its `*` continuation line), 4-node CTETRA and 3-node CTRIA3 elements;
+//! other element cards (CQUAD4, CHEXA, CPENTA, CPYRAM, CBAR, CBEAM, CROD, 10-node CTETRA) are
+//! counted as dropped and every other card is skipped. Reading stops at ENDDATA, which must be
+//! there: a file without it is truncated, and a partial mesh is never returned. Reals may use
+//! NASTRAN's implicit exponent (`-7.11-15` = -7.11e-15). GRID ids may have gaps.
+//!
+//! The writer writes free-field cards (GRID, CTETRA or CTRIA3) with coordinates in their shortest
+//! round-trip form, so a mesh reads back bit-exactly.
 
 use std::collections::HashMap;
+use std::io::Write;
 use std::path::Path;
 
-use super::{Lines, MeshData, assemble};
-use crate::{Mesh, MeshError};
+use super::raw::{Kind, RawMesh};
+use super::{Lines, MeshError};
+use crate::Mesh;
 
-pub(super) fn read<const D: usize>(path: &Path, bytes: &[u8]) -> Result<(Mesh<D>, MeshData), MeshError> {
-    if D != 3 {
-        return Err(MeshError::DimensionMismatch { path: path.to_owned(), expected: D, found: 3 });
+/// The kind of an element card, and whether its grid ids are read (only the linear simplices).
+fn element_card(card: &str) -> Option<Kind> {
+    let other = |dim, name| Some(Kind { dim, name });
+    match card {
+        "CTETRA" => Some(Kind::TETRA),
+        "CTRIA3" => Some(Kind::TRIANGLE),
+        "CQUAD4" => other(2, "quad"),
+        "CHEXA" => other(3, "hexahedron"),
+        "CPENTA" => other(3, "wedge"),
+        "CPYRAM" => other(3, "pyramid"),
+        "CBAR" | "CBEAM" | "CROD" => other(1, "bar"),
+        _ => None,
     }
+}
+
+pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut lines = Lines::new(path, bytes);
     let mut grid_index: HashMap<u64, u32> = HashMap::new();
-    let mut vertices: Vec<[f64; D]> = Vec::new();
-    // CTETRA grid ids with their line, resolved once every GRID is known (cards may come in any order).
-    let mut tets: Vec<([u64; 4], usize)> = Vec::new();
+    let mut raw = RawMesh::default();
+    // Element grid ids with their line, resolved once every GRID is known (cards may come in any order).
+    let mut elements: Vec<(Kind, Vec<u64>, usize)> = Vec::new();
     let mut complete = false;
     while let Some(line) = lines.next()? {
         if line.starts_with('$') || line.trim().is_empty() {
             continue;
         }
-        let fields = Fields::split(line).ok_or_else(|| lines.error("non-ASCII text inside a fixed-width field"))?;
+        let name = line.split(',').next().unwrap_or(line);
+        let large = name.get(..name.len().min(8)).unwrap_or(name).trim_end().ends_with('*');
+        let fields = Fields::split(line, if large { 16 } else { 8 })
+            .ok_or_else(|| lines.error("non-ASCII text inside a fixed-width field"))?;
         let card = fields.get(0).to_ascii_uppercase();
-        if card.ends_with('*') {
-            return Err(lines.error(format!("large-field card `{card}` is not supported")));
-        }
         match card.as_str() {
-            "GRID" => {
+            "GRID" | "GRID*" => {
                 let id: u64 = lines.parse(Some(fields.get(1)), "GRID id")?;
                 if !matches!(fields.get(2), "" | "0") {
                     return Err(lines.error(format!("GRID {id} uses coordinate system {}", fields.get(2))));
                 }
-                let coordinate = |i: usize| {
+                let coordinate = |fields: &Fields, i: usize, lines: &Lines| {
                     real(fields.get(i))
                         .ok_or_else(|| lines.error(format!("bad coordinate `{}` in GRID {id}", fields.get(i))))
                 };
-                let p = [coordinate(3)?, coordinate(4)?, coordinate(5)?];
-                if grid_index.insert(id, vertices.len() as u32).is_some() {
+                let (x, y) = (coordinate(&fields, 3, &lines)?, coordinate(&fields, 4, &lines)?);
+                let z = if large {
+                    let next = lines.expect("the continuation of GRID*")?;
+                    let more = Fields::split(next, 16).filter(|_| next.starts_with('*'));
+                    let more = more.ok_or_else(|| lines.error(format!("GRID* {id} has no `*` continuation line")))?;
+                    coordinate(&more, 1, &lines)?
+                } else {
+                    coordinate(&fields, 5, &lines)?
+                };
+                if grid_index.insert(id, raw.points.len() as u32).is_some() {
                     return Err(lines.error(format!("GRID {id} is defined twice")));
                 }
-                vertices.push(std::array::from_fn(|k| p[k]));
+                raw.points.push([x, y, z]);
             }
-            "CTETRA" => {
-                if !fields.get(7).is_empty() || !fields.get(8).is_empty() {
-                    return Err(lines.error("10-node CTETRA is not supported"));
-                }
-                let mut ids = [0u64; 4];
-                for (k, id) in ids.iter_mut().enumerate() {
-                    *id = lines.parse(Some(fields.get(3 + k)), "CTETRA grid id")?;
-                }
-                tets.push((ids, lines.line));
+            "CTETRA" if !fields.get(7).is_empty() || !fields.get(8).is_empty() => {
+                elements.push((Kind { dim: 3, name: "tetra10" }, Vec::new(), lines.line))
             }
             "ENDDATA" => {
                 complete = true;
                 break;
             }
-            _ => {}
+            card => {
+                if let Some(kind) = element_card(card) {
+                    let ids = if kind == Kind::TETRA || kind == Kind::TRIANGLE {
+                        (0..=kind.dim)
+                            .map(|k| lines.parse(Some(fields.get(3 + k)), &format!("{card} grid id")))
+                            .collect::<Result<Vec<u64>, _>>()?
+                    } else {
+                        Vec::new()
+                    };
+                    elements.push((kind, ids, lines.line));
+                }
+            }
         }
     }
-    if tets.is_empty() {
-        return Err(MeshError::Format { path: path.to_owned(), message: "no CTETRA elements".into() });
-    }
-    let mut cells = Vec::with_capacity(4 * tets.len());
-    for (ids, line) in tets {
-        for id in ids {
-            let v = grid_index.get(&id).ok_or_else(|| MeshError::Parse {
+    for (kind, ids, line) in elements {
+        let nodes = ids.iter().map(|id| {
+            grid_index.get(id).copied().ok_or_else(|| MeshError::Parse {
                 path: path.to_owned(),
                 line,
-                message: format!("CTETRA references GRID {id}, which is not defined"),
-            })?;
-            cells.push(*v);
-        }
+                message: format!("{} references GRID {id}, which is not defined", kind.name),
+            })
+        });
+        raw.push_cell(kind, nodes.collect::<Result<Vec<u32>, _>>()?);
     }
     if !complete {
         let message = format!("no ENDDATA after line {}: the file is truncated", lines.line);
         return Err(MeshError::Format { path: path.to_owned(), message });
     }
-    assemble(path, vertices, cells, MeshData::new())
+    Ok(raw)
 }
 
-/// The fields of one card: fixed 8-character columns, or comma-separated when the line has a
-/// comma. Field 0 is the card name; missing fields are empty.
+pub(super) fn write<const D: usize>(mesh: &Mesh<D>, w: &mut impl Write) -> std::io::Result<()> {
+    writeln!(w, "$ written by amber\nBEGIN BULK")?;
+    for (i, p) in mesh.vertices().iter().enumerate() {
+        writeln!(w, "GRID,{},,{:?},{:?},{:?}", i + 1, p[0], p[1], if D == 3 { p[2] } else { 0.0 })?;
+    }
+    let card = if D == 3 { "CTETRA" } else { "CTRIA3" };
+    for (e, cell) in mesh.elements().enumerate() {
+        write!(w, "{card},{},1", e + 1)?;
+        for &v in cell {
+            write!(w, ",{}", v + 1)?;
+        }
+        writeln!(w)?;
+    }
+    writeln!(w, "ENDDATA")
+}
+
+/// The fields of one card: fixed columns (8 characters for the name, then 8 or, in large-field
+/// cards, 16 each), or comma-separated when the line has a comma. Field 0 is the card name;
+/// missing fields are empty.
 enum Fields<'a> {
-    Fixed(&'a str),
+    Fixed(&'a str, usize),
     Free(Vec<&'a str>),
 }
 
 impl<'a> Fields<'a> {
     /// `None` if a fixed-width field would split a multi-byte character.
-    fn split(line: &'a str) -> Option<Self> {
+    fn split(line: &'a str, width: usize) -> Option<Self> {
         if line.contains(',') {
             return Some(Fields::Free(line.split(',').map(str::trim).collect()));
         }
         // Validate every column boundary once so that `get` cannot fail later.
-        (0..=line.len()).step_by(8).all(|i| line.is_char_boundary(i)).then_some(Fields::Fixed(line))
+        let boundaries = std::iter::once(0).chain((8..=line.len()).step_by(width));
+        boundaries.into_iter().all(|i| line.is_char_boundary(i)).then_some(Fields::Fixed(line, width))
     }
 
     fn get(&self, i: usize) -> &'a str {
         match self {
-            Fields::Fixed(line) => {
-                let start = (8 * i).min(line.len());
-                let end = (8 * i + 8).min(line.len());
-                line.get(start..end).unwrap_or("").trim()
+            Fields::Fixed(line, width) => {
+                let (start, end) = if i == 0 { (0, 8) } else { (8 + width * (i - 1), 8 + width * i) };
+                line.get(start.min(line.len())..end.min(line.len())).unwrap_or("").trim()
             }
             Fields::Free(fields) => fields.get(i).copied().unwrap_or(""),
         }
@@ -130,10 +173,11 @@ fn real(field: &str) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Mesh3;
+    use crate::{Mesh2, Mesh3};
 
     fn parse(text: &str) -> Result<Mesh3, MeshError> {
-        read::<3>(Path::new("inline.nas"), text.as_bytes()).map(|(mesh, _)| mesh)
+        let path = Path::new("inline.nas");
+        read(path, text.as_bytes())?.finish(path).map(|(mesh, _)| mesh)
     }
 
     /// Two tetrahedra sharing a face, one listed with negative orientation, GRID ids with gaps,
@@ -188,7 +232,7 @@ GRID          99            junk\r\n";
         let cases = [
             ("GRID           1            abc      0.      0.\n", 1, "bad coordinate `abc`"),
             ("GRID           1       5      0.      0.      0.\n", 1, "coordinate system 5"),
-            ("GRID*                  1\n", 1, "large-field"),
+            ("GRID*                  1               0              0.              0.\nGRID,2\n", 2, "continuation"),
             (
                 "GRID           1              0.      0.      0.\nGRID           1              0.      0.      0.\n",
                 2,
@@ -196,23 +240,38 @@ GRID          99            junk\r\n";
             ),
             ("CTETRA         1       1       1       2       3       4\n", 1, "GRID 1"),
             ("CTETRA         1       1       1       2       3\n", 1, "CTETRA grid id"),
-            ("CTETRA         1       1       1       2       3       4       5       6\n", 1, "10-node"),
             ("GRID          1é      0.      0.      0.\n", 1, "non-ASCII"),
         ];
         for (text, line, needle) in cases {
             let message = parse(text).unwrap_err().to_string();
             assert!(message.starts_with(&format!("inline.nas:{line}:")) && message.contains(needle), "{message}");
         }
-        assert!(parse("GRID 1 0. 0. 0.\n").unwrap_err().to_string().contains("no CTETRA"));
+        assert!(matches!(parse("GRID,1,,0.,0.,0.\nENDDATA\n"), Err(MeshError::DimensionMismatch { found: 0, .. })));
         let truncated = &TWO_TETS[..TWO_TETS.find("CTETRA         2").unwrap()];
         let message = parse(truncated).unwrap_err().to_string();
         assert!(message.contains("no ENDDATA after line 9") && message.contains("truncated"), "{message}");
         let degenerate = TWO_TETS.replace("0.25    0.25     -1.", "  0.      0.      0.");
         assert!(matches!(parse(&degenerate), Err(MeshError::InvalidMesh { .. })));
+        let path = Path::new("x.nas");
         assert!(matches!(
-            read::<2>(Path::new("x.nas"), TWO_TETS.as_bytes()),
+            read(path, TWO_TETS.as_bytes()).unwrap().finish::<2>(path),
             Err(MeshError::DimensionMismatch { expected: 2, found: 3, .. })
         ));
+    }
+
+    #[test]
+    fn reads_large_field_grids_and_writes_what_it_reads() {
+        let text = "GRID*                  1               0             0.0             0.0\n\
+*                    0.0\nGRID*                  2               0             1.0            0.0\n*       -0.5\n\
+GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA,2,1,1,2,3,4,5,6,7,8,9,10\nCQUAD4,3,1,1,2,3,4\nENDDATA\n";
+        let path = Path::new("large.nas");
+        let (mesh, data) = read(path, text.as_bytes()).unwrap().finish::<3>(path).unwrap();
+        assert_eq!(mesh.vertices()[1], [1.0, 0.0, -0.5]);
+        assert_eq!(data.dropped, std::collections::BTreeMap::from([("quad".into(), 1), ("tetra10".into(), 1)]));
+        let square = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0 / 3.0, 1.0]], vec![0, 1, 2]).unwrap();
+        let mut bytes = Vec::new();
+        write(&square, &mut bytes).unwrap();
+        assert_eq!(read(path, &bytes).unwrap().finish::<2>(path).unwrap().0, square);
     }
 
     /// Reads every console expert mesh shipped in shared/data (19 train + 2 val): positive

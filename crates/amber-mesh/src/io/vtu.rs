@@ -1,176 +1,404 @@
-//! VTK XML unstructured grid (`.vtu`) through vtkio: inline base64 binary, f64 points (z = 0 in
-//! 2D) and f64 scalar point / cell fields. The reader keeps the triangles (2D) or tetrahedra (3D)
-//! of a single-piece grid and drops lower-dimensional cells with their cell data.
+//! VTK XML unstructured grid (`.vtu`), read in every encoding VTK and meshio write: `ascii`,
+//! inline `binary` (base64, the header and the data encoded together or apart), `appended` raw or
+//! base64 data, each optionally zlib-compressed (`vtkZLibDataCompressor`), with `UInt32` or
+//! `UInt64` block headers, either byte order and any integer or float array type. The XML is
+//! parsed with quick-xml up to `<AppendedData>`, whose raw bytes are never XML.
+//!
+//! The writer writes one piece: f64 points (z = 0 in 2D), Int64 connectivity and offsets, UInt8
+//! types and the scalar fields as f64 arrays, inline base64 with `UInt64` headers (binary) or
+//! ASCII.
 
-use std::io::Write;
+use std::collections::BTreeMap;
+use std::io::{Read, Write};
 use std::path::Path;
 
-use vtkio::model::{
-    Attribute, Attributes, ByteOrder, CellType, Cells, DataArray, DataSet, ElementType, IOBuffer, Piece,
-    UnstructuredGridPiece, Version, VertexNumbers, Vtk,
-};
+use base64::Engine;
+use quick_xml::events::{BytesStart, Event};
 
-use super::{MeshData, assemble, write_error};
+use super::cursor::{Number, Scalar, as_index};
+use super::raw::RawMesh;
+use super::vtk::vtk_kind;
+use super::{Encoding, MeshData};
 use crate::{Mesh, MeshError};
 
-fn simplex_type(dim: usize) -> CellType {
-    if dim == 2 { CellType::Triangle } else { CellType::Tetra }
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Section {
+    Points,
+    Cells,
+    PointData,
+    CellData,
+    Other,
 }
 
-/// Topological dimension of a VTK cell type.
-fn cell_dim(t: CellType) -> usize {
-    use CellType::*;
-    match t {
-        Vertex | PolyVertex => 0,
-        Line | PolyLine | QuadraticEdge | CubicLine | ParametricCurve | HigherOrderEdge | LagrangeCurve
-        | BezierCurve => 1,
-        Triangle
-        | TriangleStrip
-        | Polygon
-        | Pixel
-        | Quad
-        | QuadraticTriangle
-        | QuadraticQuad
-        | BiquadraticQuad
-        | QuadraticLinearQuad
-        | BiquadraticTriangle
-        | ParametricSurface
-        | ParametricTriSurface
-        | ParametricQuadSurface
-        | HigherOrderTriangle
-        | HigherOrderQuad
-        | HigherOrderPolygon
-        | LagrangeTriangle
-        | LagrangeQuadrilateral
-        | BezierTriangle
-        | BezierQuadrilateral => 2,
-        _ => 3,
-    }
+/// How a `DataArray` holds its values.
+enum Payload {
+    Ascii,
+    Binary,
+    Appended(usize),
 }
 
-pub(super) fn read<const D: usize>(path: &Path, bytes: &[u8]) -> Result<(Mesh<D>, MeshData), MeshError> {
-    let format_error = |message: String| MeshError::Format { path: path.to_owned(), message };
-    let vtk = Vtk::parse_xml(bytes).map_err(|e| format_error(format!("not a readable VTK XML file: {e}")))?;
-    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
-        return Err(format_error("not an UnstructuredGrid".into()));
-    };
-    let piece = match <[Piece<UnstructuredGridPiece>; 1]>::try_from(pieces) {
-        Ok([Piece::Inline(piece)]) => *piece,
-        Ok(_) => return Err(format_error("the piece is not inline (parallel files are not supported)".into())),
-        Err(pieces) => return Err(format_error(format!("{} pieces, expected exactly one", pieces.len()))),
-    };
-    let UnstructuredGridPiece { points, cells, data } = piece;
-    let Cells { cell_verts, types } = cells;
-    let VertexNumbers::XML { connectivity, offsets } = cell_verts else {
-        return Err(format_error("cells are not in XML layout".into()));
-    };
-    if offsets.len() != types.len() {
-        return Err(format_error(format!("{} cell offsets but {} cell types", offsets.len(), types.len())));
-    }
-    let found = types.iter().map(|&t| cell_dim(t)).max().unwrap_or(0);
-    if found != D {
-        return Err(MeshError::DimensionMismatch { path: path.to_owned(), expected: D, found });
-    }
-    let mut kept = Vec::new();
-    let mut cells = Vec::new();
-    let mut start = 0usize;
-    for (i, (&t, &end)) in types.iter().zip(&offsets).enumerate() {
-        let end = end as usize;
-        let nodes = connectivity
-            .get(start..end)
-            .ok_or_else(|| format_error(format!("cell {i} has offsets {start}..{end} outside the connectivity")))?;
-        start = end;
-        if cell_dim(t) < D {
-            continue;
-        }
-        if t != simplex_type(D) || nodes.len() != D + 1 {
-            return Err(format_error(format!("cell {i} is a {t:?}; only linear {D}D simplices are supported")));
-        }
-        kept.push(i);
-        // Out-of-range indices become u32::MAX and are reported by `assemble`.
-        cells.extend(nodes.iter().map(|&v| u32::try_from(v).unwrap_or(u32::MAX)));
-    }
+struct Array {
+    section: Section,
+    name: String,
+    ty: Scalar,
+    components: usize,
+    payload: Payload,
+    text: String,
+}
 
-    let points: Vec<f64> = points.cast_into().ok_or_else(|| format_error("unreadable point coordinates".into()))?;
-    if !points.len().is_multiple_of(3) {
-        return Err(format_error(format!("{} point coordinates, not a multiple of 3", points.len())));
+/// The file-wide settings of `<VTKFile>`.
+struct Header {
+    big_endian: bool,
+    header: Scalar,
+    compressed: bool,
+}
+
+pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
+    let error = |message: String| MeshError::Format { path: path.to_owned(), message };
+    let (xml, appended) = split_appended(bytes).map_err(|m| error(m.into()))?;
+    let mut reader = quick_xml::Reader::from_reader(xml);
+    let mut header = Header { big_endian: false, header: Scalar::U32, compressed: false };
+    let mut section = Section::Other;
+    let mut arrays: Vec<Array> = Vec::new();
+    let mut current: Option<Array> = None;
+    let mut counts: Option<(usize, usize)> = None;
+    let mut grid = false;
+    loop {
+        let at = reader.buffer_position();
+        let event = reader.read_event().map_err(|e| error(format!("byte {at}: not well-formed XML: {e}")))?;
+        let xml_error = |message: String| MeshError::AtByte { path: path.to_owned(), offset: at as usize, message };
+        match event {
+            Event::Empty(e) if e.local_name().as_ref() == "DataArray" => {
+                arrays.push(attributes(&e).and_then(|attrs| new_array(section, &attrs)).map_err(xml_error)?);
+            }
+            Event::Start(e) if e.local_name().as_ref() == "DataArray" => {
+                current = Some(attributes(&e).and_then(|attrs| new_array(section, &attrs)).map_err(xml_error)?);
+            }
+            Event::Start(e) | Event::Empty(e) => {
+                let attrs = attributes(&e).map_err(xml_error)?;
+                let get = |key: &str| attrs.get(key).map(String::as_str);
+                match e.local_name().as_ref() {
+                    "VTKFile" => {
+                        if get("type") != Some("UnstructuredGrid") {
+                            return Err(error(format!(
+                                "a VTK {} file, not an UnstructuredGrid",
+                                get("type").unwrap_or("?")
+                            )));
+                        }
+                        header.big_endian = get("byte_order") == Some("BigEndian");
+                        header.header = match get("header_type") {
+                            None | Some("UInt32") => Scalar::U32,
+                            Some("UInt64") => Scalar::U64,
+                            Some(other) => return Err(xml_error(format!("header_type {other} is not supported"))),
+                        };
+                        header.compressed = match get("compressor") {
+                            None | Some("") => false,
+                            Some("vtkZLibDataCompressor") => true,
+                            Some(other) => {
+                                return Err(xml_error(format!("compressor {other} is not supported, only zlib")));
+                            }
+                        };
+                    }
+                    "UnstructuredGrid" => grid = true,
+                    "Piece" => {
+                        if counts.is_some() {
+                            return Err(xml_error("more than one piece: only single-piece grids are supported".into()));
+                        }
+                        let count = |key: &str| -> Result<usize, MeshError> {
+                            let text = get(key).unwrap_or("");
+                            text.parse().map_err(|_| xml_error(format!("{key}=\"{text}\" is not a count")))
+                        };
+                        counts = Some((count("NumberOfPoints")?, count("NumberOfCells")?));
+                    }
+                    "Points" => section = Section::Points,
+                    "Cells" => section = Section::Cells,
+                    "PointData" => section = Section::PointData,
+                    "CellData" => section = Section::CellData,
+                    _ => {}
+                }
+            }
+            Event::Text(t) => {
+                if let Some(array) = &mut current {
+                    array.text.push_str(&t);
+                }
+            }
+            Event::End(e) => match e.local_name().as_ref() {
+                "DataArray" => arrays.extend(current.take()),
+                "Points" | "Cells" | "PointData" | "CellData" => section = Section::Other,
+                _ => {}
+            },
+            Event::Eof => break,
+            _ => {}
+        }
     }
-    let vertices = points
-        .chunks_exact(3)
-        .enumerate()
-        .map(|(i, p)| {
-            if D == 2 && p[2] != 0.0 {
-                Err(format_error(format!("point {i} has z = {}; a 2D mesh must lie in the plane z = 0", p[2])))
+    if !grid {
+        return Err(error("no <UnstructuredGrid>".into()));
+    }
+    let (num_points, num_cells) = counts.ok_or_else(|| error("no <Piece>".into()))?;
+    let appended_offsets: Vec<usize> =
+        arrays.iter().filter_map(|a| if let Payload::Appended(o) = a.payload { Some(o) } else { None }).collect();
+    let mut raw = RawMesh::default();
+    let mut cell_arrays: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
+    for array in &arrays {
+        let values = decode(array, &header, &appended, &appended_offsets)
+            .map_err(|m| error(format!("DataArray `{}`: {m}", array.name)))?;
+        let expected = |n: usize| {
+            if values.len() == n * array.components {
+                Ok(())
             } else {
-                Ok(std::array::from_fn(|k| p[k]))
+                let expected = n * array.components;
+                Err(error(format!("DataArray `{}` has {} values, expected {expected}", array.name, values.len())))
             }
-        })
-        .collect::<Result<Vec<[f64; D]>, _>>()?;
-
-    let mut mesh_data = MeshData::new();
-    let scalar_fields = |attributes: Vec<Attribute>, expected: usize, kind: &str| {
-        let mut fields = Vec::new();
-        for attribute in attributes {
-            let Attribute::DataArray(DataArray { name, elem, data }) = attribute else { continue };
-            if !matches!(elem, ElementType::Scalars { num_comp: 1, .. } | ElementType::Generic(1)) {
-                continue;
+        };
+        match array.section {
+            Section::Points => {
+                expected(num_points)?;
+                if array.components != 3 {
+                    return Err(error(format!("points have {} components, expected 3", array.components)));
+                }
+                raw.points = values.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
             }
-            let values: Vec<f64> =
-                data.cast_into().ok_or_else(|| format_error(format!("{kind} field `{name}` is not numeric")))?;
-            if values.len() != expected {
-                return Err(MeshError::DataLength {
-                    path: path.to_owned(),
-                    field: format!("{kind} field `{name}`"),
-                    len: values.len(),
-                    expected,
-                });
+            Section::Cells => {
+                cell_arrays.insert(array.name.as_str(), values);
             }
-            fields.push((name, values));
+            Section::PointData | Section::CellData if array.components == 1 => {
+                let (n, fields) = if array.section == Section::PointData {
+                    (num_points, &mut raw.point_data)
+                } else {
+                    (num_cells, &mut raw.cell_data)
+                };
+                expected(n)?;
+                fields.insert(array.name.clone(), values);
+            }
+            _ => {}
         }
-        Ok(fields)
-    };
-    let Attributes { point, cell } = data;
-    mesh_data.point.extend(scalar_fields(point, vertices.len(), "vertex")?);
-    for (name, values) in scalar_fields(cell, types.len(), "element")? {
-        mesh_data.cell.insert(name, kept.iter().map(|&i| values[i]).collect());
     }
-    assemble(path, vertices, cells, mesh_data)
+    let mut cell_array =
+        |name: &str| cell_arrays.remove(name).ok_or_else(|| error(format!("no `{name}` array in <Cells>")));
+    let (connectivity, offsets, types) = (cell_array("connectivity")?, cell_array("offsets")?, cell_array("types")?);
+    if offsets.len() != num_cells || types.len() != num_cells {
+        let message = format!("{} offsets and {} types for {num_cells} cells", offsets.len(), types.len());
+        return Err(error(message));
+    }
+    raw.nodes = connectivity
+        .iter()
+        .map(|&v| as_index(v).ok_or_else(|| error(format!("connectivity entry {v} is not a point index"))))
+        .collect::<Result<_, _>>()?;
+    let mut start = 0;
+    for (i, (&t, &end)) in types.iter().zip(&offsets).enumerate() {
+        let kind =
+            as_index(t).and_then(|t| vtk_kind(t as u8)).ok_or_else(|| error(format!("cell {i}: unknown type {t}")))?;
+        let end = as_index(end).map(|e| e as usize).filter(|&e| e >= start && e <= raw.nodes.len());
+        let end = end.ok_or_else(|| error(format!("cell {i}: offset outside the connectivity")))?;
+        raw.kinds.push(kind);
+        raw.ends.push(end);
+        start = end;
+    }
+    Ok(raw)
+}
+
+/// The attributes of an element, unescaped.
+fn attributes(e: &BytesStart) -> Result<BTreeMap<String, String>, String> {
+    let mut map = BTreeMap::new();
+    for attr in e.attributes() {
+        let attr = attr.map_err(|err| format!("bad attribute: {err}"))?;
+        let key = attr.key.as_ref().to_owned();
+        let value = quick_xml::escape::unescape(&attr.value).map_err(|err| format!("attribute {key}: {err}"))?;
+        map.insert(key, value.into_owned());
+    }
+    Ok(map)
+}
+
+fn new_array(section: Section, attrs: &BTreeMap<String, String>) -> Result<Array, String> {
+    let get = |key: &str| attrs.get(key).map(String::as_str);
+    let type_name = get("type").unwrap_or("");
+    let ty = Scalar::from_vtk_xml(type_name).ok_or_else(|| format!("DataArray type `{type_name}` is not supported"))?;
+    let components = match get("NumberOfComponents") {
+        None => 1,
+        Some(text) => text.parse().ok().filter(|&n| n > 0).ok_or(format!("NumberOfComponents=\"{text}\""))?,
+    };
+    let payload = match get("format") {
+        Some("ascii") => Payload::Ascii,
+        Some("binary") => Payload::Binary,
+        Some("appended") => {
+            let text = get("offset").unwrap_or("");
+            Payload::Appended(text.parse().map_err(|_| format!("appended DataArray with offset=\"{text}\""))?)
+        }
+        other => return Err(format!("DataArray format {other:?} is not supported")),
+    };
+    let name = get("Name").unwrap_or("").to_owned();
+    Ok(Array { section, name, ty, components, payload, text: String::new() })
+}
+
+/// The appended data after the `_` marker of `<AppendedData>`.
+struct Appended<'a> {
+    bytes: &'a [u8],
+    base64: bool,
+}
+
+/// The XML before `<AppendedData>`, and the appended data (empty if none).
+fn split_appended(bytes: &[u8]) -> Result<(&[u8], Appended<'_>), &'static str> {
+    let tag = b"<AppendedData";
+    let Some(start) = bytes.windows(tag.len()).position(|w| w == tag) else {
+        return Ok((bytes, Appended { bytes: &[], base64: false }));
+    };
+    let marker = bytes[start..].iter().position(|&b| b == b'_').ok_or("<AppendedData> without the `_` marker")?;
+    let base64 = bytes[start..start + marker].windows(8).any(|w| w == b"\"base64\"");
+    let data = &bytes[start + marker + 1..];
+    let end = data.windows(15).rposition(|w| w == b"</AppendedData>").unwrap_or(data.len());
+    Ok((&bytes[..start], Appended { bytes: &data[..end], base64 }))
+}
+
+/// The values of one array, as f64.
+fn decode(array: &Array, header: &Header, appended: &Appended, offsets: &[usize]) -> Result<Vec<f64>, String> {
+    let data = match array.payload {
+        Payload::Ascii => {
+            return array
+                .text
+                .split_ascii_whitespace()
+                .map(|w| w.parse::<f64>().map_err(|_| format!("`{w}` is not a number")))
+                .collect();
+        }
+        Payload::Binary => block(&base64_segments(array.text.as_bytes())?, header)?,
+        Payload::Appended(offset) => {
+            let rest = appended.bytes.get(offset..).ok_or(format!("offset {offset} is past the appended data"))?;
+            if appended.base64 {
+                // Appended base64: this array's text runs to the next offset.
+                let end = offsets.iter().filter(|&&o| o > offset).min().map_or(rest.len(), |&o| o - offset);
+                block(&base64_segments(&rest[..end])?, header)?
+            } else {
+                block(rest, header)?
+            }
+        }
+    };
+    if data.len() % array.ty.size() != 0 {
+        return Err(format!("{} bytes, not a whole number of {:?} values", data.len(), array.ty));
+    }
+    Ok(array.ty.decode(&data, header.big_endian))
+}
+
+/// Decodes base64 that may be several streams back to back (VTK and meshio encode the block
+/// header and the data apart, each with its own padding), ignoring whitespace.
+fn base64_segments(text: &[u8]) -> Result<Vec<u8>, String> {
+    let text: Vec<u8> = text.iter().copied().filter(|b| !b.is_ascii_whitespace()).collect();
+    let mut out = Vec::with_capacity(text.len() / 4 * 3);
+    let mut rest = &text[..];
+    while !rest.is_empty() {
+        let pad = rest.iter().position(|&b| b == b'=');
+        let end = pad.map_or(rest.len(), |p| p + rest[p..].iter().take_while(|&&b| b == b'=').count());
+        base64::engine::general_purpose::STANDARD
+            .decode_vec(&rest[..end], &mut out)
+            .map_err(|e| format!("bad base64: {e}"))?;
+        rest = &rest[end..];
+    }
+    Ok(out)
+}
+
+/// The data of one block-headed payload: `[n][data]` uncompressed, or `[blocks][block size]
+/// [last size][compressed sizes...][zlib blocks...]`. Counts are checked against the bytes
+/// present, and no block inflates past its announced size.
+fn block(bytes: &[u8], header: &Header) -> Result<Vec<u8>, String> {
+    let h = header.header.size();
+    let word = |i: usize| -> Result<usize, String> {
+        let b = bytes.get(i * h..(i + 1) * h).ok_or("truncated block header")?;
+        let x = header.header.decode(b, header.big_endian)[0];
+        // Header words are unsigned; anything near 2^50 is corrupt, not a size.
+        (x < 1e15).then_some(x as usize).ok_or(format!("block header value {x}"))
+    };
+    if !header.compressed {
+        let n = word(0)?;
+        return bytes
+            .get(h..h + n)
+            .map(<[u8]>::to_vec)
+            .ok_or(format!("{n} bytes announced, {} present", bytes.len() - h));
+    }
+    let blocks = word(0)?;
+    if blocks.saturating_add(3).saturating_mul(h) > bytes.len() {
+        return Err(format!("{blocks} compressed blocks announced in {} bytes", bytes.len()));
+    }
+    let (size, last) = (word(1)?, word(2)?);
+    let mut start = (3 + blocks) * h;
+    let mut out = Vec::new();
+    for b in 0..blocks {
+        let compressed = word(3 + b)?;
+        let data = bytes.get(start..start + compressed).ok_or(format!("compressed block {b} is truncated"))?;
+        start += compressed;
+        let expected = if b + 1 == blocks && last != 0 { last } else { size };
+        let before = out.len();
+        flate2::read::ZlibDecoder::new(data)
+            .take(expected as u64)
+            .read_to_end(&mut out)
+            .map_err(|e| format!("block {b} is not valid zlib data: {e}"))?;
+        if out.len() - before != expected {
+            return Err(format!("block {b} inflates to {} bytes, expected {expected}", out.len() - before));
+        }
+    }
+    Ok(out)
 }
 
 pub(super) fn write<const D: usize>(
     mesh: &Mesh<D>,
     data: &MeshData,
+    binary: bool,
     w: &mut impl Write,
-    path: &Path,
-) -> Result<(), MeshError> {
+) -> std::io::Result<()> {
+    let encoding = if binary { Encoding::Binary } else { Encoding::Ascii };
+    let (nv, ne) = (mesh.num_vertices(), mesh.num_elements());
+    writeln!(w, "<?xml version=\"1.0\"?>")?;
+    writeln!(
+        w,
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
+    )?;
+    writeln!(w, "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{nv}\" NumberOfCells=\"{ne}\">")?;
+    for (tag, fields) in [("PointData", &data.point), ("CellData", &data.cell)] {
+        writeln!(w, "<{tag}>")?;
+        for (name, values) in fields {
+            data_array(w, name, 1, values, encoding)?;
+        }
+        writeln!(w, "</{tag}>")?;
+    }
     let points: Vec<f64> = mesh.vertices().iter().flat_map(|p| [p[0], p[1], if D == 3 { p[2] } else { 0.0 }]).collect();
-    let n = (D + 1) as u64;
-    let cells = Cells {
-        cell_verts: VertexNumbers::XML {
-            connectivity: mesh.cells().iter().map(|&v| u64::from(v)).collect(),
-            offsets: (1..=mesh.num_elements() as u64).map(|e| e * n).collect(),
-        },
-        types: vec![simplex_type(D); mesh.num_elements()],
-    };
-    let scalars = |fields: &std::collections::BTreeMap<String, Vec<f64>>| {
-        fields
-            .iter()
-            .map(|(name, values)| Attribute::DataArray(DataArray::scalars(name.as_str(), 1).with_data(values.clone())))
-            .collect()
-    };
-    let vtk = Vtk {
-        // Version 1.0 goes with the 64-bit block headers vtkio writes.
-        version: Version::new((1, 0)),
-        title: String::new(),
-        byte_order: ByteOrder::LittleEndian,
-        file_path: None,
-        data: DataSet::inline(UnstructuredGridPiece {
-            points: IOBuffer::F64(points),
-            cells,
-            data: Attributes { point: scalars(&data.point), cell: scalars(&data.cell) },
-        }),
-    };
-    vtk.write_xml(&mut *w).map_err(|e| write_error(path)(std::io::Error::other(e.to_string())))
+    writeln!(w, "<Points>")?;
+    data_array(w, "Points", 3, &points, encoding)?;
+    writeln!(w, "</Points>\n<Cells>")?;
+    let connectivity: Vec<i64> = mesh.cells().iter().map(|&v| i64::from(v)).collect();
+    let offsets: Vec<i64> = (1..=ne as i64).map(|e| e * (D as i64 + 1)).collect();
+    data_array(w, "connectivity", 1, &connectivity, encoding)?;
+    data_array(w, "offsets", 1, &offsets, encoding)?;
+    data_array(w, "types", 1, &vec![if D == 2 { 5u8 } else { 10 }; ne], encoding)?;
+    writeln!(w, "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>")
+}
+
+/// One `<DataArray>`: base64 of the UInt64 byte count, then base64 of the little-endian values
+/// (encoded apart, as VTK does), or the values as text.
+fn data_array<T: Number>(
+    w: &mut impl Write,
+    name: &str,
+    components: usize,
+    values: &[T],
+    encoding: Encoding,
+) -> std::io::Result<()> {
+    let name = quick_xml::escape::escape(name);
+    let format = if encoding == Encoding::Binary { "binary" } else { "ascii" };
+    write!(
+        w,
+        "<DataArray type=\"{}\" Name=\"{name}\" NumberOfComponents=\"{components}\" format=\"{format}\">",
+        T::VTK
+    )?;
+    if encoding == Encoding::Binary {
+        let mut bytes = Vec::with_capacity(size_of_val(values));
+        for v in values {
+            v.put(false, &mut bytes);
+        }
+        let b64 = base64::engine::general_purpose::STANDARD;
+        w.write_all(b64.encode((bytes.len() as u64).to_le_bytes()).as_bytes())?;
+        w.write_all(b64.encode(&bytes).as_bytes())?;
+    } else {
+        for (i, v) in values.iter().enumerate() {
+            write!(w, "{}{v:?}", if i == 0 { "" } else { " " })?;
+        }
+    }
+    writeln!(w, "</DataArray>")
 }
 
 #[cfg(test)]
@@ -182,72 +410,91 @@ mod tests {
         Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![0, 1, 2, 0, 2, 3]).unwrap()
     }
 
-    fn to_text<const D: usize>(mesh: &Mesh<D>, data: &MeshData) -> String {
+    fn to_text<const D: usize>(mesh: &Mesh<D>, data: &MeshData, binary: bool) -> String {
         let mut bytes = Vec::new();
-        write(mesh, data, &mut bytes, Path::new("x.vtu")).unwrap();
+        write(mesh, data, binary, &mut bytes).unwrap();
         String::from_utf8(bytes).unwrap()
     }
 
     fn parse<const D: usize>(text: &str) -> Result<(Mesh<D>, MeshData), MeshError> {
-        read(Path::new("inline.vtu"), text.as_bytes())
+        let path = Path::new("inline.vtu");
+        read(path, text.as_bytes())?.finish(path)
     }
 
     #[test]
-    fn writes_binary_f64_that_reads_back_exactly() {
+    fn writes_binary_and_ascii_f64_that_read_back_exactly() {
         let mesh = square();
         let data =
             MeshData::new().with_cell("h", vec![0.1 + 0.2, 1.0 / 3.0]).with_point("u", vec![1e-300, 2.0, 3.0, 4.0]);
-        let text = to_text(&mesh, &data);
-        assert!(text.contains("format=\"binary\"") && text.contains("type=\"Float64\""), "{text}");
-        assert_eq!(parse::<2>(&text).unwrap(), (mesh, data));
+        for binary in [true, false] {
+            let text = to_text(&mesh, &data, binary);
+            assert!(text.contains("type=\"Float64\""), "{text}");
+            assert_eq!(parse::<2>(&text).unwrap(), (mesh.clone(), data.clone()));
+        }
     }
 
     #[test]
     fn drops_lower_dimensional_cells_with_their_data() {
-        // The same square with a boundary line cell added in front, as other tools write it.
-        let text = to_text(&square(), &MeshData::new().with_cell("h", vec![1.0, 2.0]));
-        let mut vtk = Vtk::parse_xml(text.as_bytes()).unwrap();
-        let DataSet::UnstructuredGrid { pieces, .. } = &mut vtk.data else { unreachable!() };
-        let Piece::Inline(piece) = &mut pieces[0] else { unreachable!() };
-        piece.cells = Cells {
-            cell_verts: VertexNumbers::XML { connectivity: vec![0, 1, 0, 1, 2, 0, 2, 3], offsets: vec![2, 5, 8] },
-            types: vec![CellType::Line, CellType::Triangle, CellType::Triangle],
-        };
-        piece.data.cell = vec![Attribute::DataArray(DataArray::scalars("h", 1).with_data(vec![9.0, 1.0, 2.0]))];
+        let text = "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"3\" NumberOfCells=\"2\">\
+<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0</DataArray></Points>\
+<CellData><DataArray type=\"Float64\" Name=\"h\" format=\"ascii\">9 1</DataArray></CellData>\
+<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 0 1 2</DataArray>\
+<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">2 5</DataArray>\
+<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">3 5</DataArray></Cells></Piece></UnstructuredGrid></VTKFile>";
+        let (mesh, data) = parse::<2>(text).unwrap();
+        assert_eq!(mesh.num_elements(), 1);
+        assert_eq!(data.cell["h"], vec![1.0]);
+        assert_eq!(data.dropped, BTreeMap::from([("line".into(), 1)]));
+        assert!(matches!(parse::<3>(text), Err(MeshError::DimensionMismatch { found: 2, .. })));
+    }
+
+    #[test]
+    fn reads_compressed_blocks_and_rejects_bad_ones() {
+        let header = Header { big_endian: false, header: Scalar::U32, compressed: true };
+        let payload: Vec<u8> = (0..100u8).collect();
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        z.write_all(&payload[..64]).unwrap();
+        let first = z.finish().unwrap();
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        z.write_all(&payload[64..]).unwrap();
+        let second = z.finish().unwrap();
         let mut bytes = Vec::new();
-        vtk.write_xml(&mut bytes).unwrap();
-        let (mesh, data) = read::<2>(Path::new("x.vtu"), &bytes).unwrap();
-        assert_eq!(mesh, square());
-        assert_eq!(data.cell["h"], vec![1.0, 2.0]);
-        assert!(matches!(read::<3>(Path::new("x.vtu"), &bytes), Err(MeshError::DimensionMismatch { found: 2, .. })));
+        for word in [2, 64, 36, first.len() as u32, second.len() as u32] {
+            bytes.extend_from_slice(&word.to_le_bytes());
+        }
+        bytes.extend_from_slice(&first);
+        bytes.extend_from_slice(&second);
+        assert_eq!(block(&bytes, &header).unwrap(), payload);
+        let mut bad = bytes.clone();
+        let last = bad.len() - 3;
+        bad[last] ^= 0xff;
+        assert!(block(&bad, &header).unwrap_err().contains("block 1"));
+        assert!(block(&bytes[..30], &header).unwrap_err().contains("truncated"));
+        let mut huge = bytes.clone();
+        huge[..4].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(block(&huge, &header).unwrap_err().contains("blocks announced"));
     }
 
     #[test]
     fn malformed_files_are_errors_not_panics() {
-        let text = to_text(&square(), &MeshData::new().with_cell("h", vec![1.0, 2.0]));
+        let text = to_text(&square(), &MeshData::new().with_cell("h", vec![1.0, 2.0]), true);
         for cut in [0, 10, text.len() / 2, text.len() - 20] {
             let err = parse::<2>(&text[..cut]).unwrap_err();
-            assert!(err.to_string().starts_with("inline.vtu: "), "{err}");
+            assert!(err.to_string().starts_with("inline.vtu"), "{err}");
         }
         assert!(parse::<2>("<VTKFile type=\"PolyData\"></VTKFile>").is_err());
         let garbles = [
-            (">YAAAAAAAAAA", ">YAAAA!!AAAA"), // not base64
-            ("NumberOfPoints=\"4\"", "NumberOfPoints=\"5\""),
-            ("NumberOfCells=\"2\"", "NumberOfCells=\"x\""),
-            ("AgAAAAAAAAAFBQ==", "AgAAAAAAAAAFCg=="), // a tetrahedron among the triangles
-            ("AgAAAAAAAAAFBQ==", "AgAAAAAAAAAFCQ=="), // a quad
-            ("EAAAAAAAAAADAAAAAAAAAAYAAAAAAAAA", "EAAAAAAAAAADAAAAAAAAAAcAAAAAAAAA"), // offsets past the end
+            ("EAAAAAAAAAA=AAAAAAAA8D8AAAAAAAAAQA==", "EAAAAAAAAAA=AAAA!!AA8D8AAAAAAAAAQA==", "bad base64"),
+            ("NumberOfPoints=\"4\"", "NumberOfPoints=\"5\"", "expected 15"),
+            ("NumberOfCells=\"2\"", "NumberOfCells=\"x\"", "not a count"),
+            ("AgAAAAAAAAA=BQU=", "AgAAAAAAAAA=BQo=", "3D mesh"),
+            ("AgAAAAAAAAA=BQU=", "AgAAAAAAAAA=Bf8=", "unknown type 255"),
+            ("AgAAAAAAAAA=BQU=", "AwAAAAAAAAA=BQU=", "3 bytes announced"),
         ];
-        for (from, to) in garbles {
+        for (from, to, needle) in garbles {
             assert!(text.contains(from), "{from}");
-            let result = parse::<2>(&text.replacen(from, to, 1));
-            assert!(result.is_err(), "{to}: {result:?}");
+            let message = parse::<2>(&text.replacen(from, to, 1)).unwrap_err().to_string();
+            assert!(message.starts_with("inline.vtu") && message.contains(needle), "{message}");
         }
-        // Points replaced by two coordinates (the payload of "h").
-        let start = text.find("NumberOfComponents=\"3\">").unwrap() + 23;
-        let end = start + text[start..].find('<').unwrap();
-        let short = format!("{}EAAAAAAAAAAAAAAAAADwPwAAAAAAAABA{}", &text[..start], &text[end..]);
-        let err = parse::<2>(&short).unwrap_err();
-        assert!(err.to_string().contains("SizeMismatch"), "{err}");
     }
 }

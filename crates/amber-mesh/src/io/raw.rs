@@ -1,0 +1,149 @@
+//! What every mixed-element reader (`.msh`, `.vtu`, `.vtk`, `.nas`, `.inp`, `.mesh`) produces
+//! before a mesh is built: points in 3D and cells of any kind in file order. [`RawMesh::finish`]
+//! is the one place that decides the dimension, keeps the simplices of it, turns tagged facets
+//! into [`MeshData::facet_tags`] and counts what it dropped.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use super::{MeshData, assemble};
+use crate::{Mesh, MeshError};
+
+/// A cell kind: its topological dimension and whether it is the linear simplex of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Kind {
+    pub(super) dim: usize,
+    pub(super) name: &'static str,
+}
+
+impl Kind {
+    pub(super) const VERTEX: Kind = Kind { dim: 0, name: "vertex" };
+    pub(super) const LINE: Kind = Kind { dim: 1, name: "line" };
+    pub(super) const TRIANGLE: Kind = Kind { dim: 2, name: "triangle" };
+    pub(super) const TETRA: Kind = Kind { dim: 3, name: "tetra" };
+
+    /// The linear simplex of dimension `dim` (0 to 3).
+    pub(super) fn simplex(dim: usize) -> Kind {
+        [Self::VERTEX, Self::LINE, Self::TRIANGLE, Self::TETRA][dim]
+    }
+
+    fn is_simplex(self) -> bool {
+        self == Self::simplex(self.dim)
+    }
+}
+
+#[derive(Default)]
+pub(super) struct RawMesh {
+    pub(super) points: Vec<[f64; 3]>,
+    pub(super) kinds: Vec<Kind>,
+    /// Point indices of every cell, cell after cell.
+    pub(super) nodes: Vec<u32>,
+    /// End of every cell's nodes in `nodes`.
+    pub(super) ends: Vec<usize>,
+    /// A tag per cell (gmsh physical group, medit reference, 0 for none), or empty when the
+    /// format has none.
+    pub(super) tags: Vec<i32>,
+    /// Per-cell fields over all cells, in file order.
+    pub(super) cell_data: BTreeMap<String, Vec<f64>>,
+    pub(super) point_data: BTreeMap<String, Vec<f64>>,
+}
+
+impl RawMesh {
+    pub(super) fn push_cell(&mut self, kind: Kind, nodes: impl IntoIterator<Item = u32>) {
+        self.kinds.push(kind);
+        self.nodes.extend(nodes);
+        self.ends.push(self.nodes.len());
+    }
+
+    fn cell(&self, i: usize) -> &[u32] {
+        &self.nodes[if i == 0 { 0 } else { self.ends[i - 1] }..self.ends[i]]
+    }
+
+    /// The highest dimension of the cells (0 without cells).
+    pub(super) fn dimension(&self) -> usize {
+        self.kinds.iter().map(|k| k.dim).max().unwrap_or(0)
+    }
+
+    /// Builds the `D`-dimensional mesh: fails with [`MeshError::DimensionMismatch`] when the
+    /// highest cell dimension is not `D` (so a caller can try the other), keeps the linear
+    /// `D`-simplices with their cell data, records tagged `(D-1)`-simplices as facet tags and
+    /// counts every other cell in [`MeshData::dropped`].
+    pub(super) fn finish<const D: usize>(self, path: &Path) -> Result<(Mesh<D>, MeshData), MeshError> {
+        let found = self.dimension();
+        if found != D {
+            return Err(MeshError::DimensionMismatch { path: path.to_owned(), expected: D, found });
+        }
+        let format_error = |message: String| MeshError::Format { path: path.to_owned(), message };
+        if D == 2
+            && let Some((i, p)) = self.points.iter().enumerate().find(|(_, p)| p[2] != 0.0)
+        {
+            return Err(format_error(format!("point {i} has z = {}; a 2D mesh must lie in the plane z = 0", p[2])));
+        }
+        if let Some((i, _)) = self.points.iter().enumerate().find(|(_, p)| p.iter().any(|x| !x.is_finite())) {
+            return Err(format_error(format!("point {i} has a non-finite coordinate")));
+        }
+        let mut data = MeshData::new();
+        let mut kept = Vec::new();
+        let mut cells = Vec::new();
+        for (i, &kind) in self.kinds.iter().enumerate() {
+            let nodes = self.cell(i);
+            if nodes.len() != kind.dim + 1 && kind.is_simplex() {
+                return Err(format_error(format!("cell {i} is a {} with {} nodes", kind.name, nodes.len())));
+            }
+            if kind == Kind::simplex(D) {
+                kept.push(i);
+                cells.extend_from_slice(nodes);
+                continue;
+            }
+            *data.dropped.entry(kind.name.to_owned()).or_default() += 1;
+            let tag = self.tags.get(i).copied().unwrap_or(0);
+            if kind == Kind::simplex(D - 1) && tag != 0 {
+                let mut facet = nodes.to_vec();
+                facet.sort_unstable();
+                data.facet_tags.insert(facet, tag);
+            }
+        }
+        for (name, values) in self.cell_data {
+            if values.len() != self.kinds.len() {
+                let field = format!("element field `{name}`");
+                return Err(MeshError::DataLength {
+                    path: path.to_owned(),
+                    field,
+                    len: values.len(),
+                    expected: self.kinds.len(),
+                });
+            }
+            data.cell.insert(name, kept.iter().map(|&i| values[i]).collect());
+        }
+        data.point = self.point_data;
+        let vertices = self.points.iter().map(|p| std::array::from_fn(|k| p[k])).collect();
+        assemble(path, vertices, cells, data)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keeps_simplices_of_the_dimension_and_counts_the_rest() {
+        let mut raw = RawMesh {
+            points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]],
+            ..Default::default()
+        };
+        raw.push_cell(Kind::LINE, [0, 1]);
+        raw.push_cell(Kind::TRIANGLE, [0, 1, 2]);
+        raw.push_cell(Kind { dim: 2, name: "quad" }, [0, 1, 3, 2]);
+        raw.push_cell(Kind::VERTEX, [3]);
+        raw.tags = vec![7, 1, 1, 0];
+        raw.cell_data.insert("h".into(), vec![0.0, 1.0, 2.0, 3.0]);
+        let (mesh, data) = raw.finish::<2>(Path::new("x")).unwrap();
+        assert_eq!(mesh.num_elements(), 1);
+        assert_eq!(data.cell["h"], vec![1.0]);
+        assert_eq!(data.dropped, BTreeMap::from([("line".into(), 1), ("quad".into(), 1), ("vertex".into(), 1)]));
+        assert_eq!(data.facet_tags, BTreeMap::from([(vec![0, 1], 7)]));
+        let raw = RawMesh { points: vec![[0.0; 3]], kinds: vec![Kind::LINE], ..Default::default() };
+        let err = raw.finish::<2>(Path::new("x")).unwrap_err();
+        assert!(matches!(err, MeshError::DimensionMismatch { found: 1, .. }), "{err}");
+    }
+}

@@ -1,0 +1,314 @@
+#!/usr/bin/env python3
+"""Round trips of `amber convert` against the real tools, meshio and gmsh.
+
+read:  meshio and gmsh write a 2D triangle mesh and a 3D tetrahedral mesh (with a cell array
+       `size`) in every format and encoding they have; `amber convert` turns each into JSON,
+       which must hold the same vertices (to 1e-12), the same elements and the same `size`.
+write: `amber convert` writes a reference mesh (JSON with `size`) in every format and encoding
+       it has; meshio and gmsh read each back: same vertex and element counts, same coordinates
+       (to 1e-12), `size` preserved (meshio, where the format stores cell data), physical groups
+       present (.msh).
+
+Prints a table format x encoding x direction x tool -> pass/fail (the tool that wrote the file
+for `read`, the one that read amber's file for `write`) and exits non-zero on any failure.
+Usage: roundtrip.py [AMBER_BINARY] (default: $AMBER_BIN, else target/debug/amber).
+"""
+
+import contextlib
+import io
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import traceback
+
+import gmsh
+import meshio
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+AMBER = sys.argv[1] if len(sys.argv) > 1 else os.environ.get("AMBER_BIN", os.path.join(ROOT, "target/debug/amber"))
+TOL = 1e-12
+SIMPLEX = {2: "triangle", 3: "tetra"}
+
+
+def gmsh_model(dim):
+    """A unit square or cube meshed by gmsh, with physical groups `domain` and `boundary`."""
+    gmsh.model.add(f"m{dim}")
+    if dim == 2:
+        gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
+    else:
+        gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.3 if dim == 2 else 0.45)
+    domain = [t for _, t in gmsh.model.getEntities(dim)]
+    boundary = [t for _, t in gmsh.model.getEntities(dim - 1)]
+    gmsh.model.addPhysicalGroup(dim, domain, 1, "domain")
+    gmsh.model.addPhysicalGroup(dim - 1, boundary, 2, "boundary")
+    gmsh.model.mesh.generate(dim)
+
+
+def reference(dim, directory):
+    """The gmsh mesh as (points, cells, size), and the path of the same mesh as amber JSON."""
+    restart_gmsh()
+    gmsh_model(dim)
+    path = os.path.join(directory, f"gmsh{dim}.msh")
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.write(path)
+    m = meshio.read(path)
+    cells = np.concatenate([c.data for c in m.cells if c.type == SIMPLEX[dim]])
+    used = np.unique(cells)
+    remap = -np.ones(len(m.points), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    points, cells = m.points[used], remap[cells]
+    size = 0.1 + np.arange(len(cells)) / 7.0
+    ref = os.path.join(directory, f"ref{dim}.json")
+    with open(ref, "w") as f:
+        json.dump({"dimension": dim, "vertices": points[:, :dim].tolist(), "elements": cells.tolist(),
+                   "cell_data": {"size": size.tolist()}}, f)
+    return points, cells, size, ref
+
+
+def amber_convert(src, dst, *flags):
+    env = dict(os.environ, RUST_BACKTRACE="0")
+    run = subprocess.run([AMBER, "convert", src, dst, *flags], capture_output=True, text=True, env=env)
+    if run.returncode != 0:
+        raise RuntimeError(run.stderr.strip())
+
+
+def same_points(expected, got, tol=TOL):
+    """Same points to TOL, in order or (for tools that renumber) as sorted sets."""
+    expected, got = np.asarray(expected, float), np.asarray(got, float)
+    if expected.shape != got.shape:
+        raise AssertionError(f"{len(got)} points, expected {len(expected)}")
+    if np.abs(expected - got).max() <= tol:
+        return
+    order = lambda p: p[np.lexsort(np.round(p, 5).T[::-1])]
+    diff = np.abs(order(expected) - order(got)).max()
+    if diff > tol:
+        raise AssertionError(f"coordinates differ by {diff}")
+
+
+def same_cells(expected_points, expected, got_points, got):
+    """Same elements, each matched through its nearest expected vertices (independent of
+    numbering and orientation)."""
+    if len(expected) != len(got):
+        raise AssertionError(f"{len(got)} elements, expected {len(expected)}")
+    expected_points, got_points = np.asarray(expected_points), np.asarray(got_points)
+    nearest = np.array([np.argmin(((expected_points - p) ** 2).sum(axis=1)) for p in got_points])
+    key = lambda cells: sorted(tuple(sorted(c)) for c in np.asarray(cells).tolist())
+    if key(expected) != key(nearest[np.asarray(got)]):
+        raise AssertionError("different elements")
+
+
+def same_values(expected, got, what):
+    if got is None:
+        raise AssertionError(f"no {what}")
+    if len(got) != len(expected) or np.abs(np.asarray(got) - expected).max() > TOL:
+        raise AssertionError(f"{what} differs")
+
+
+def check_amber_json(path, dim, points, cells, size, tol=TOL):
+    with open(path) as f:
+        m = json.load(f)
+    if m["dimension"] != dim:
+        raise AssertionError(f"dimension {m['dimension']}")
+    got_points = np.zeros((len(m["vertices"]), 3))
+    got_points[:, :dim] = m["vertices"]
+    same_points(points, got_points, tol)
+    same_cells(points, cells, got_points, np.array(m["elements"]))
+    if size is not None:
+        same_values(size, m.get("cell_data", {}).get("size"), "cell data `size`")
+
+
+def as_read_by_meshio(path, dim):
+    """What meshio reads from a file (points, simplices, `size`), the truth for files that round
+    their numbers (meshio's ASCII .vtu keeps 12 digits); None where meshio cannot read it."""
+    try:
+        quiet = io.StringIO()  # meshio prints its failures
+        with contextlib.redirect_stdout(quiet), contextlib.redirect_stderr(quiet):
+            m = meshio_read(path)
+    except (Exception, SystemExit):  # noqa: BLE001 - fall back to the reference mesh
+        return None
+    got = np.concatenate([c.data for c in m.cells if c.type == SIMPLEX[dim]])
+    points = np.zeros((len(m.points), 3))
+    points[:, : m.points.shape[1]] = m.points
+    used = np.unique(got)
+    remap = -np.ones(len(points), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    blocks = [np.ravel(d) for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == SIMPLEX[dim]]
+    return points[used], remap[got], np.concatenate(blocks) if blocks else None
+
+
+def meshio_inputs(dim, points, cells, size, directory):
+    """(format, encoding, path, carries cell data) for every file meshio writes."""
+    pts = points if dim == 3 else points[:, :2]
+    mesh = meshio.Mesh(pts, [(SIMPLEX[dim], cells)], cell_data={"size": [size]})
+    mesh3 = meshio.Mesh(points, [(SIMPLEX[dim], cells)], cell_data={"size": [size]})
+    out = []
+
+    def add(fmt, encoding, name, write, data=True):
+        path = os.path.join(directory, f"meshio{dim}-{name}")
+        write(path)
+        out.append((fmt, encoding, path, data))
+
+    add("vtu", "ascii", "a.vtu", lambda p: meshio.vtu.write(p, mesh3, binary=False))
+    add("vtu", "binary", "b.vtu", lambda p: meshio.vtu.write(p, mesh3, binary=True, compression=None))
+    add("vtu", "binary zlib", "z.vtu", lambda p: meshio.vtu.write(p, mesh3, binary=True, compression="zlib"))
+    add("vtu", "binary UInt64", "u64.vtu",
+        lambda p: meshio.vtu.write(p, mesh3, binary=True, compression=None, header_type="UInt64"))
+    add("vtk", "ascii 5.1", "a.vtk", lambda p: meshio.vtk.write(p, mesh3, binary=False))
+    add("vtk", "binary 5.1", "b.vtk", lambda p: meshio.vtk.write(p, mesh3, binary=True))
+    add("vtk", "ascii 4.2", "a42.vtk", lambda p: meshio.vtk.write(p, mesh3, binary=False, fmt_version="4.2"))
+    add("vtk", "binary 4.2", "b42.vtk", lambda p: meshio.vtk.write(p, mesh3, binary=True, fmt_version="4.2"))
+    # meshio 5.3 writes ASCII $ElementData values as `np.float64(0.1)` under numpy 2: those
+    # files carry no cell data here.
+    bare = meshio.Mesh(points, [(SIMPLEX[dim], cells)])
+    for version, name in [("gmsh22", "2.2"), ("gmsh", "4.1")]:
+        for binary in [False, True]:
+            enc = f"{name} {'binary' if binary else 'ascii'}"
+            add("msh", enc, f"{version}-{int(binary)}.msh",
+                lambda p, v=version, b=binary: meshio.write(p, mesh3 if b else bare, file_format=v, binary=b), binary)
+    add("nas", "ascii", "a.nas", lambda p: meshio.write(p, mesh3, file_format="nastran"), data=False)
+    add("inp", "ascii", "a.inp", lambda p: meshio.write(p, mesh, file_format="abaqus"), data=False)
+    add("mesh", "ascii", "a.mesh", lambda p: meshio.write(p, mesh, file_format="medit"), data=False)
+    return out
+
+
+def gmsh_inputs(dim, size, directory):
+    """Files gmsh writes from the reference model; .msh files get `size` appended as a view."""
+    out = []
+    gmsh.option.setNumber("PostProcessing.SaveMesh", 0)
+    for version in ["2.2", "4.1"]:
+        for binary in [0, 1]:
+            path = os.path.join(directory, f"gmsh{dim}-{version}-{binary}.msh")
+            gmsh.option.setNumber("Mesh.MshFileVersion", float(version))
+            gmsh.option.setNumber("Mesh.Binary", binary)
+            gmsh.write(path)
+            types, tags, _ = gmsh.model.mesh.getElements(dim)
+            view = gmsh.view.add("size")
+            simplex_tags = [t for ty, t in zip(types, tags) if ty in (2, 4)][0]
+            gmsh.view.addHomogeneousModelData(view, 0, gmsh.model.getCurrent(), "ElementData", simplex_tags, size)
+            gmsh.view.write(view, path, append=True)
+            gmsh.view.remove(view)
+            out.append(("msh", f"{version} {'binary' if binary else 'ascii'}", path, True))
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    for ext, enc, binary in [("vtk", "ascii", 0), ("vtk", "binary", 1), ("mesh", "ascii", 0), ("bdf", "ascii", 0)]:
+        path = os.path.join(directory, f"gmsh{dim}-{enc}.{ext}")
+        gmsh.option.setNumber("Mesh.Binary", binary)
+        gmsh.write(path)
+        out.append((ext if ext != "bdf" else "nas", enc, path, False))
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    return out
+
+
+def meshio_read(path):
+    """meshio.read, told that .msh is gmsh (else a failure tries ANSYS and exits the process)."""
+    return meshio.read(path, file_format="gmsh" if path.endswith(".msh") else None)
+
+
+def read_with_meshio(path, dim, points, cells, size, has_data, physical):
+    m = meshio_read(path)
+    got = np.concatenate([c.data for c in m.cells if c.type == SIMPLEX[dim]])
+    got_points = np.zeros((len(m.points), 3))
+    got_points[:, : m.points.shape[1]] = m.points
+    same_points(points, got_points)
+    same_cells(points, cells, got_points, got)
+    if has_data:
+        blocks = [np.ravel(d) for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == SIMPLEX[dim]]
+        same_values(size, np.concatenate(blocks) if blocks else None, "cell data `size`")
+    if physical and not {"domain", "boundary"} <= set(m.field_data):
+        raise AssertionError(f"physical names {sorted(m.field_data)}")
+
+
+def restart_gmsh():
+    """A fresh gmsh: after a failed open gmsh 4.15 stays "busy" and ignores the next ones."""
+    if gmsh.isInitialized():
+        gmsh.finalize()
+    gmsh.initialize(readConfigFiles=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+
+
+def read_with_gmsh(path, dim, points, cells, physical):
+    restart_gmsh()
+    gmsh.open(path)
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    got_points = np.asarray(coords).reshape(-1, 3)
+    index = {t: i for i, t in enumerate(tags)}
+    types, _, nodes = gmsh.model.mesh.getElements(dim)
+    simplex = [n for t, n in zip(types, nodes) if t in (2, 4)]
+    got = np.array([index[t] for t in np.concatenate(simplex)] if simplex else [], dtype=int).reshape(-1, dim + 1)
+    same_points(points, got_points)
+    same_cells(points, cells, got_points, got.astype(int))
+    if physical:
+        groups = set(gmsh.model.getPhysicalGroups())
+        if not {(dim, 1), (dim - 1, 1)} <= groups:
+            raise AssertionError(f"physical groups {sorted(groups)}")
+
+
+def main():
+    results = []
+
+    def record(fmt, encoding, direction, tool, check):
+        try:
+            check()
+            results.append((fmt, encoding, direction, tool, "pass", ""))
+        except (Exception, SystemExit) as e:  # noqa: BLE001 - every failure is a table row
+            detail = str(e).splitlines()[-1] if str(e) else traceback.format_exc().splitlines()[-1]
+            results.append((fmt, encoding, direction, tool, "FAIL", detail[:90]))
+
+    with tempfile.TemporaryDirectory() as directory:
+        for dim in [2, 3]:
+            points, cells, size, ref = reference(dim, directory)
+            inputs = [("meshio", *i) for i in meshio_inputs(dim, points, cells, size, directory)]
+            inputs += [("gmsh", *i) for i in gmsh_inputs(dim, size, directory)]
+            for tool, fmt, encoding, path, has_data in inputs:
+                out = path + ".json"
+
+                def read_check(path=path, out=out, has_data=has_data):
+                    amber_convert(path, out)
+                    if path.endswith(".bdf"):
+                        # gmsh writes 8-character fields (7 digits), which meshio misreads
+                        # when they touch: compare with the reference to 1e-6.
+                        check_amber_json(out, dim, points, cells, None, 1e-6)
+                        return
+                    expected = as_read_by_meshio(path, dim) or (points, cells, size)
+                    expected_size = expected[2] if expected[2] is not None else size
+                    check_amber_json(out, dim, *expected[:2], expected_size if has_data else None)
+
+                record(fmt, f"{encoding} {dim}D", "read", tool, read_check)
+            outputs = [("vtu", "binary", ["--binary"]), ("vtu", "ascii", ["--ascii"]), ("vtk", "ascii", []),
+                       ("vtk", "binary", ["--binary"]), ("msh", "ascii", []), ("msh", "binary", ["--binary"]),
+                       ("nas", "ascii", []), ("inp", "ascii", []), ("mesh", "ascii", [])]
+            for fmt, encoding, flags in outputs:
+                path = os.path.join(directory, f"amber{dim}-{encoding}.{fmt}")
+                has_data = fmt in ("vtu", "vtk", "msh")
+                try:
+                    amber_convert(ref, path, *flags)
+                except Exception as e:  # noqa: BLE001
+                    record(fmt, f"{encoding} {dim}D", "write", "amber", lambda e=e: (_ for _ in ()).throw(e))
+                    continue
+                record(fmt, f"{encoding} {dim}D", "write", "meshio",
+                       lambda: read_with_meshio(path, dim, points, cells, size, has_data, fmt == "msh"))
+                # gmsh 4.15 fails to read binary legacy VTK, even the files it writes itself.
+                if fmt in ("msh", "mesh", "nas") or (fmt, encoding) == ("vtk", "ascii"):
+                    record(fmt, f"{encoding} {dim}D", "write", "gmsh",
+                           lambda: read_with_gmsh(path, dim, points, cells, fmt == "msh"))
+    gmsh.finalize()
+
+    width = [max(len(r[i]) for r in results) for i in range(5)]
+    header = ("format", "encoding", "direction", "tool", "result")
+    width = [max(w, len(h)) for w, h in zip(width, header)]
+    line = lambda r: "  ".join(c.ljust(w) for c, w in zip(r, width))
+    print(line(header))
+    for r in results:
+        print(line(r[:5]) + (f"  {r[5]}" if r[5] else ""))
+    failures = sum(r[4] != "pass" for r in results)
+    print(f"\n{len(results) - failures} passed, {failures} failed")
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    main()
