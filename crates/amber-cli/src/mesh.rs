@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use amber_experiments::{ModelCard, Task, resolve_model};
-use amber_mesh::{Mesh, Mesh2, Mesh3, MeshData, read_mesh, read_mesh_with_data, write_mesh};
+use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, MeshData, read_any_mesh, read_mesh, read_mesh_with_data, write_mesh};
 use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
 use amber_plot::{RenderOptions, View, render_png, render_surface_png};

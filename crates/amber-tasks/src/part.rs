@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use amber_graph::FeatureSet;
-use amber_mesh::{Mesh, Mesh3, StlFaceIds, read_mesh, read_surface};
+use amber_mesh::{AnyMesh, Mesh, Mesh3, StlFaceIds, read_any_mesh, read_surface};
 use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, Surface, generate_3d};
 use amber_meshgen::{ConstantSize, MeshSizing, MeshgenError, PolygonDomain};
 
@@ -30,10 +30,12 @@ pub fn read_solid_surface(path: &Path, feature_angle: f64) -> Result<Surface, Ta
             let soup = read_surface(path, StlFaceIds::FromFile).map_err(|e| geometry(e.to_string()))?;
             Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(|e| geometry(e.to_string()))?
         }
-        _ => {
-            let mesh = read_mesh::<3>(path).map_err(|e| geometry(format!("neither a surface nor a tet mesh: {e}")))?;
-            Surface::from_mesh_boundary(&mesh).map_err(|e| geometry(format!("boundary of the tet mesh: {e}")))?
-        }
+        _ => match read_any_mesh(path).map_err(|e| geometry(format!("neither a surface nor a tet mesh: {e}")))? {
+            AnyMesh::Three(mesh, _) => {
+                Surface::from_mesh_boundary(&mesh).map_err(|e| geometry(format!("boundary of the tet mesh: {e}")))?
+            }
+            AnyMesh::Two(..) => return Err(geometry("holds triangles (a 2D geometry), not a solid".into())),
+        },
     };
     if surface.face_ids().iter().all(|&id| id == surface.face_ids()[0]) {
         surface.split_faces_at_feature_edges(feature_angle);
@@ -55,8 +57,12 @@ pub fn read_polygon_domain(path: &Path) -> Result<PolygonDomain, TaskError> {
             return serde_json::from_value(value).map_err(|e| geometry(format!("not a valid polygon domain: {e}")));
         }
     }
-    let mesh = read_mesh::<2>(path).map_err(|e| geometry(format!("neither a polygon nor a triangle mesh: {e}")))?;
-    PolygonDomain::from_mesh_boundary(&mesh).map_err(|e| geometry(format!("boundary of the mesh: {e}")))
+    match read_any_mesh(path).map_err(|e| geometry(format!("neither a polygon nor a triangle mesh: {e}")))? {
+        AnyMesh::Two(mesh, _) => {
+            PolygonDomain::from_mesh_boundary(&mesh).map_err(|e| geometry(format!("boundary of the mesh: {e}")))
+        }
+        AnyMesh::Three(..) => Err(geometry("holds tetrahedra (a 3D geometry), not a planar domain".into())),
+    }
 }
 
 /// A solid to mesh: its bounding surface and M⁰.

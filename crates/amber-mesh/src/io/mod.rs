@@ -312,22 +312,6 @@ pub fn write_mesh_as<const D: usize>(
     }
 }
 
-/// The boundary facets of a mesh, outward oriented (counter-clockwise around the element in 2D,
-/// normal pointing out of it in 3D), each with the vertex list a facet tag is keyed by.
-fn boundary_facets<const D: usize>(mesh: &Mesh<D>) -> Result<Vec<Vec<u32>>, MeshError> {
-    const OUTWARD_2: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
-    const OUTWARD_3: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
-    let adjacency = crate::FacetAdjacency::new(mesh)?;
-    Ok(adjacency
-        .boundary_facets()
-        .map(|(e, local)| {
-            let cell = mesh.element(e);
-            let corners: &[usize] = if D == 2 { &OUTWARD_2[local] } else { &OUTWARD_3[local] };
-            corners.iter().map(|&k| cell[k]).collect()
-        })
-        .collect())
-}
-
 /// The facets a writer stores with their tags: every tagged facet, and the untagged boundary
 /// facets with `untagged` (one past the largest tag, or 1 when nothing is tagged).
 fn tagged_facets<const D: usize>(
@@ -344,7 +328,8 @@ fn tagged_facets<const D: usize>(
     let untagged = data.facet_tags.values().max().map_or(1, |&t| t.saturating_add(1));
     let mut facets: Vec<(Vec<u32>, i32)> = Vec::new();
     let mut seen = std::collections::BTreeSet::new();
-    for facet in boundary_facets(mesh)? {
+    for facet in crate::FacetAdjacency::new(mesh)?.oriented_boundary_facets(mesh) {
+        let facet = facet.to_vec();
         let mut key = facet.clone();
         key.sort_unstable();
         facets.push((facet, data.facet_tags.get(&key).copied().unwrap_or(untagged)));
