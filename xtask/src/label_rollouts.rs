@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use amber_experiments::{Task, amber_config};
 use amber_graph::Aggregation;
 use amber_tasks::poisson::read_split;
-use amber_tasks::{MeshLimits, Problem, StepOutcome, generation_step, labels};
+use amber_tasks::{Domain, MeshLimits, Problem, StepOutcome, generation_step, labels};
 use amber_train::{MeshMetrics, Reference};
 use anyhow::Context;
 use rayon::prelude::*;

@@ -1,8 +1,10 @@
 //! The `amber` command line.
 //!
 //! `amber mesh` meshes a geometry with a trained model (or a given sizing field) into a mesh file
-//! or picture; `amber train` trains AMBER.
+//! or picture; `amber train` trains AMBER (on generated Poisson problems or a folder of expert
+//! meshes); `amber evaluate` scores a model on a folder of expert meshes.
 
+mod evaluate;
 mod mesh;
 mod train;
 
@@ -19,8 +21,11 @@ struct Cli {
 enum Command {
     /// Mesh a geometry with a trained model (or a sizing field); write .vtu, .msh, .json or .png.
     Mesh(mesh::MeshArgs),
-    /// Train AMBER (resumes a killed run in the same --out directory).
+    /// Train AMBER on a folder of expert meshes (--data DIR with train/ and val/) or on Poisson
+    /// problems (resumes a killed run in the same --out directory).
     Train(train::TrainArgs),
+    /// Score a model on a folder of expert meshes: evaluation.json, evaluation.md, a picture per part.
+    Evaluate(evaluate::EvaluateArgs),
 }
 
 #[global_allocator]
@@ -35,5 +40,6 @@ fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Mesh(args) => mesh::run(args),
         Command::Train(args) => train::train(args),
+        Command::Evaluate(args) => evaluate::run(args),
     }
 }
