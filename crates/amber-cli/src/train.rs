@@ -52,6 +52,10 @@ pub struct TrainArgs {
     /// Split seeds and sizes.
     #[arg(long, default_value = "datasets/poisson.json")]
     manifest: PathBuf,
+    /// Folder datasets: the edge length of every part's uniform M⁰ (default: the folder's
+    /// `dataset.json`, else 4 × the median training expert element size).
+    #[arg(long)]
+    initial_size: Option<f64>,
     /// Run directory: config, log, checkpoints, and the model in `<out>/model`.
     #[arg(long)]
     out: PathBuf,
@@ -92,7 +96,7 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
         }
         amber_experiments::Task::Folder { dimension } => {
             let label = format!("{} {} seed {}", args.method, args.data.display(), args.seed);
-            let trained = train_folder(&config, dimension, &args.data, &args.out, &label)?;
+            let trained = train_folder(&config, dimension, &args.data, args.initial_size, &args.out, &label)?;
             let data = format!("{} ({} training parts, {dimension}D)", args.data.display(), trained.parts);
             (trained.seconds, trained.initial_size, data)
         }

@@ -23,16 +23,19 @@ pub struct FolderTraining {
 
 /// Trains the run of `config` on the dataset folder `data` of `dimension`-dimensional meshes
 /// (`amber_tasks::folder::mesh_dimension`) into `dir` (resuming what `dir` holds): the first
-/// `train_problems` parts of `train/`, validating on the first `val_problems` of `val/`. `label`
-/// names the run in progress lines.
+/// `train_problems` parts of `train/`, validating on the first `val_problems` of `val/`, M⁰ of
+/// size `initial_size` when given (else `dataset.json`'s, else the default rule). `label` names
+/// the run in progress lines.
 pub fn train_folder(
     config: &MethodConfig,
     dimension: usize,
     data: &Path,
+    initial_size: Option<f64>,
     dir: &Path,
     label: &str,
 ) -> anyhow::Result<FolderTraining> {
-    let settings = DatasetSettings::read(data)?;
+    let mut settings = DatasetSettings::read(data)?;
+    settings.initial_size = initial_size.or(settings.initial_size);
     match dimension {
         2 => train_parts::<2, PlanarPart>(config, data, &settings, dir, label),
         3 => train_parts::<3, SolidPart>(config, data, &settings, dir, label),
