@@ -13,7 +13,7 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 
 /// The learning tasks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum Task {
     /// Poisson problems on random L-shapes (spec §1).
     Poisson,
@@ -63,11 +63,14 @@ pub struct TrainArgs {
 
 pub fn train(args: TrainArgs) -> anyhow::Result<()> {
     let task = args.task.unwrap_or(if args.data.join("train").is_dir() { Task::Folder } else { Task::Poisson });
-    let profile_task = match task {
-        Task::Poisson => amber_experiments::Task::Poisson,
-        Task::Folder => amber_experiments::Task::Folder { dimension: mesh_dimension(&Split::Train.dir(&args.data))? },
+    // A folder's dimension: its meshes'.
+    let dimension = match task {
+        Task::Poisson => None,
+        Task::Folder => Some(mesh_dimension(&Split::Train.dir(&args.data))?),
     };
-    let mut config = amber_config(profile_task, args.profile);
+    let card_task =
+        dimension.map_or(amber_experiments::Task::Poisson, |dimension| amber_experiments::Task::Folder { dimension });
+    let mut config = amber_config(card_task, args.profile);
     config.aggregation = args.method.aggregation();
     config.seed = args.seed as u64;
     if let Some(path) = &args.config {
@@ -81,8 +84,8 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
     let inference_steps = config.inference_steps;
     let config = MethodConfig::Amber(config);
     config.validate()?;
-    let (seconds, initial_size, data) = match profile_task {
-        amber_experiments::Task::Poisson | amber_experiments::Task::Console => {
+    let (seconds, initial_size, data) = match dimension {
+        None => {
             let label = format!("{} {} seed {}", args.method, args.difficulty, args.seed);
             let seconds = train_poisson(&config, args.difficulty, &args.data, &args.manifest, &args.out, &label)?;
             let data = format!(
@@ -94,7 +97,7 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
             );
             (seconds, INITIAL_SIZE, data)
         }
-        amber_experiments::Task::Folder { dimension } => {
+        Some(dimension) => {
             let label = format!("{} {} seed {}", args.method, args.data.display(), args.seed);
             let trained = train_folder(&config, dimension, &args.data, args.initial_size, &args.out, &label)?;
             let data = format!("{} ({} training parts, {dimension}D)", args.data.display(), trained.parts);
@@ -103,7 +106,7 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
     };
     let model = args.out.join(MODEL_DIR);
     let card = ModelCard {
-        task: profile_task,
+        task: card_task,
         method: args.method.to_string(),
         inference_steps,
         initial_size,
