@@ -214,6 +214,7 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     }
     let table = std::fs::read_to_string(out.join("evaluation.md")).unwrap();
     assert!(table.contains("| test/plate00 |") && table.contains("**mean**"), "{table}");
+    println!("{table}");
 
     let mesh = dir.path().join("plate.vtu");
     let plate = data.join("test/plate00.msh");
