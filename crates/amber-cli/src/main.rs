@@ -1,9 +1,12 @@
 //! The `amber` command line.
 //!
 //! `amber mesh` meshes a geometry with a trained model (or a given sizing field) into a mesh file
-//! or picture; `amber train` trains AMBER; `amber convert` converts between mesh file formats.
+//! or picture; `amber train` trains AMBER (on generated Poisson problems or a folder of expert
+//! meshes); `amber evaluate` scores a model on a folder of expert meshes; `amber convert`
+//! converts between mesh file formats.
 
 mod convert;
+mod evaluate;
 mod mesh;
 mod train;
 
@@ -20,10 +23,13 @@ struct Cli {
 enum Command {
     /// Mesh a geometry with a trained model (or a sizing field); write .vtu, .msh, .json or .png.
     Mesh(mesh::MeshArgs),
-    /// Train AMBER (resumes a killed run in the same --out directory).
+    /// Train AMBER on a folder of expert meshes (--data DIR with train/ and val/) or on Poisson
+    /// problems (resumes a killed run in the same --out directory).
     Train(train::TrainArgs),
     /// Convert a mesh file: .msh, .vtu, .vtk, .nas, .inp, .mesh, .json in, any of them out.
     Convert(convert::ConvertArgs),
+    /// Score a model on a folder of expert meshes: evaluation.json, evaluation.md, a picture per part.
+    Evaluate(evaluate::EvaluateArgs),
 }
 
 #[global_allocator]
@@ -39,5 +45,6 @@ fn main() -> anyhow::Result<()> {
         Command::Mesh(args) => mesh::run(args),
         Command::Train(args) => train::train(args),
         Command::Convert(args) => convert::run(args),
+        Command::Evaluate(args) => evaluate::run(args),
     }
 }

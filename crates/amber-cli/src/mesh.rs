@@ -8,8 +8,8 @@ use amber_experiments::{ModelCard, Task, resolve_model};
 use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, MeshData, read_any_mesh, read_mesh, read_mesh_with_data, write_mesh};
 use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
-use amber_plot::{RenderOptions, View, render_png, render_surface_png};
-use amber_tasks::part::{FEATURE_ANGLE_DEGREES, SolidPart, read_polygon_domain, read_solid_surface};
+use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
+use amber_tasks::part::{FEATURE_ANGLE_DEGREES, PlanarPart, SolidPart, read_polygon_domain, read_solid_surface};
 use amber_tasks::poisson::{PoissonPart, read_part, read_problem};
 use amber_tasks::{Domain, WithExpert};
 use amber_train::{ElementTarget, GeneratedStep, MeshMetrics, Reference, TrainedModel};
@@ -75,9 +75,7 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
 
 /// `--model`: the model's task decides what the geometry becomes.
 fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
-    let shipped = std::env::var_os("AMBER_MODELS")
-        .map_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models"), PathBuf::from);
-    let dir = resolve_model(model, &shipped)?;
+    let dir = resolve_model(model, &shipped_models())?;
     let card = ModelCard::read(&dir)?;
     let mut trained = TrainedModel::load(&dir).with_context(|| format!("{}: cannot load the model", dir.display()))?;
     // A user's geometry is meshed whatever the field asks for: over the budget, it is scaled to it.
@@ -102,17 +100,38 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             };
             mesh_domain(args, &trained, part, expert, steps)
         }
-        Task::Console => {
+        Task::Console | Task::Folder { dimension: 3 } => {
             let geometry = args.geometry.as_deref().context("give the geometry to mesh: a closed STL or a tet mesh")?;
             let path = Path::new(geometry);
             let surface = read_solid_surface(path, args.feature_angle)?;
-            let name = path.file_stem().map_or_else(|| geometry.to_owned(), |s| s.to_string_lossy().into_owned());
-            let part = SolidPart::new(name, surface, card.initial_size)
+            let part = SolidPart::new(part_name(geometry), surface, card.initial_size)
                 .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
             let expert = args.expert.as_deref().map(read_mesh::<3>).transpose()?;
             mesh_domain(args, &trained, part, expert, steps)
         }
+        Task::Folder { dimension: 2 } => {
+            let geometry = args.geometry.as_deref().unwrap_or("lshape");
+            let part = PlanarPart::new(part_name(geometry), planar_domain(args)?, card.initial_size)
+                .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
+            let expert = args.expert.as_deref().map(read_mesh::<2>).transpose()?;
+            mesh_domain(args, &trained, part, expert, steps)
+        }
+        Task::Folder { dimension } => {
+            bail!("{}: a model of {dimension}D meshes; amber meshes 2D and 3D", dir.display())
+        }
     }
+}
+
+/// What reports call a part: the geometry file's stem.
+fn part_name(geometry: &str) -> String {
+    Path::new(geometry).file_stem().map_or_else(|| geometry.to_owned(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Where shipped models are: `$AMBER_MODELS`, else the `models/` directory of the repository the
+/// binary was built from.
+pub(crate) fn shipped_models() -> PathBuf {
+    std::env::var_os("AMBER_MODELS")
+        .map_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models"), PathBuf::from)
 }
 
 /// Rolls the model out on `domain`, scores each step against `expert` when there is one, and
@@ -188,21 +207,33 @@ where
     Ok(())
 }
 
+/// The viewpoint of pictures of 3D meshes.
+const VIEW: View = View { azimuth_deg: 35.0, elevation_deg: 30.0 };
+
 /// A picture of a mesh coloured by per-element values: the mesh itself in 2D, its boundary
-/// surface in 3D.
-trait Picture {
+/// surface in 3D; alone, or as a tile of a gallery.
+pub(crate) trait Picture {
     fn picture(&self, values: &[f64], options: &RenderOptions, path: &Path) -> anyhow::Result<()>;
+    fn tile_mesh(&self) -> TileMesh<'_>;
 }
 
 impl Picture for Mesh2 {
     fn picture(&self, values: &[f64], options: &RenderOptions, path: &Path) -> anyhow::Result<()> {
         Ok(render_png(self, values, options, path)?)
     }
+
+    fn tile_mesh(&self) -> TileMesh<'_> {
+        TileMesh::Flat(self)
+    }
 }
 
 impl Picture for Mesh3 {
     fn picture(&self, values: &[f64], options: &RenderOptions, path: &Path) -> anyhow::Result<()> {
-        Ok(render_surface_png(self, values, options, View { azimuth_deg: 35.0, elevation_deg: 30.0 }, path)?)
+        Ok(render_surface_png(self, values, options, VIEW, path)?)
+    }
+
+    fn tile_mesh(&self) -> TileMesh<'_> {
+        TileMesh::Solid(self, VIEW)
     }
 }
 

@@ -1,10 +1,12 @@
 //! `amber train`: trains AMBER on a task with a named profile into a run directory (resumes a
-//! killed run there) and writes the model's card.
+//! killed run there) and writes the model's card. The task is a dataset folder of expert meshes
+//! when `--data` holds a `train/` directory, else generated Poisson problems.
 
 use std::path::PathBuf;
 
-use amber_experiments::{Method, ModelCard, amber_config, commit, merge_json, train_poisson};
+use amber_experiments::{Method, ModelCard, amber_config, commit, merge_json, train_folder, train_poisson};
 use amber_stdx::read_json;
+use amber_tasks::folder::{Split, mesh_dimension};
 use amber_tasks::poisson::{Difficulty, INITIAL_SIZE};
 use amber_train::{MODEL_DIR, MethodConfig, Profile};
 use anyhow::Context;
@@ -15,12 +17,16 @@ use clap::{Args, ValueEnum};
 pub enum Task {
     /// Poisson problems on random L-shapes (spec §1).
     Poisson,
+    /// A dataset folder: `DIR/train/`, `DIR/val/` of expert meshes (any format amber reads), with
+    /// optional geometry files and `DIR/dataset.json`.
+    Folder,
 }
 
 #[derive(Args)]
 pub struct TrainArgs {
-    #[arg(long, value_enum, default_value = "poisson")]
-    task: Task,
+    /// The task (default: `folder` when --data holds a `train/` directory, else `poisson`).
+    #[arg(long, value_enum)]
+    task: Option<Task>,
     /// smoke (minutes), quick (about 30 minutes on 2 cores), paper (GPU scale).
     #[arg(long, default_value = "quick")]
     profile: Profile,
@@ -39,20 +45,32 @@ pub struct TrainArgs {
     /// A JSON file of training-config fields overriding the profile's.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Dataset root (problems are generated there when missing).
+    /// A dataset folder of expert meshes (`train/`, `val/`), or the Poisson dataset root (problems
+    /// are generated there when missing).
     #[arg(long, default_value = "data/poisson")]
     data: PathBuf,
     /// Split seeds and sizes.
     #[arg(long, default_value = "datasets/poisson.json")]
     manifest: PathBuf,
+    /// Folder datasets: the edge length of every part's uniform M⁰ (default: the folder's
+    /// `dataset.json`, else 4 × the median training expert element size).
+    #[arg(long)]
+    initial_size: Option<f64>,
     /// Run directory: config, log, checkpoints, and the model in `<out>/model`.
     #[arg(long)]
     out: PathBuf,
 }
 
 pub fn train(args: TrainArgs) -> anyhow::Result<()> {
-    let Task::Poisson = args.task;
-    let mut config = amber_config(amber_experiments::Task::Poisson, args.profile);
+    let task = args.task.unwrap_or(if args.data.join("train").is_dir() { Task::Folder } else { Task::Poisson });
+    // A folder's dimension: its meshes'.
+    let dimension = match task {
+        Task::Poisson => None,
+        Task::Folder => Some(mesh_dimension(&Split::Train.dir(&args.data))?),
+    };
+    let card_task =
+        dimension.map_or(amber_experiments::Task::Poisson, |dimension| amber_experiments::Task::Folder { dimension });
+    let mut config = amber_config(card_task, args.profile);
     config.aggregation = args.method.aggregation();
     config.seed = args.seed as u64;
     if let Some(path) = &args.config {
@@ -63,25 +81,37 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
     if let Some(steps) = args.steps {
         config.steps = steps;
     }
-    let label = format!("{} {} seed {}", args.method, args.difficulty, args.seed);
     let inference_steps = config.inference_steps;
     let config = MethodConfig::Amber(config);
     config.validate()?;
-    let seconds = train_poisson(&config, args.difficulty, &args.data, &args.manifest, &args.out, &label)?;
+    let (seconds, initial_size, data) = match dimension {
+        None => {
+            let label = format!("{} {} seed {}", args.method, args.difficulty, args.seed);
+            let seconds = train_poisson(&config, args.difficulty, &args.data, &args.manifest, &args.out, &label)?;
+            let data = format!(
+                "{} problems of {}, difficulty {}, seed {}",
+                args.data.display(),
+                args.manifest.display(),
+                args.difficulty,
+                args.seed
+            );
+            (seconds, INITIAL_SIZE, data)
+        }
+        Some(dimension) => {
+            let label = format!("{} {} seed {}", args.method, args.data.display(), args.seed);
+            let trained = train_folder(&config, dimension, &args.data, args.initial_size, &args.out, &label)?;
+            let data = format!("{} ({} training parts, {dimension}D)", args.data.display(), trained.parts);
+            (trained.seconds, trained.initial_size, data)
+        }
+    };
     let model = args.out.join(MODEL_DIR);
     let card = ModelCard {
-        task: amber_experiments::Task::Poisson,
+        task: card_task,
         method: args.method.to_string(),
         inference_steps,
-        initial_size: INITIAL_SIZE,
+        initial_size,
         command: std::env::args().collect::<Vec<_>>().join(" "),
-        data: format!(
-            "{} problems of {}, difficulty {}, seed {}",
-            args.data.display(),
-            args.manifest.display(),
-            args.difficulty,
-            args.seed
-        ),
+        data,
         commit: commit().to_owned(),
         training_seconds: seconds,
         evaluation: None,

@@ -7,10 +7,12 @@ use std::path::{Path, PathBuf};
 
 use amber_mesh::Mesh3;
 use amber_plot::{Tile, TileMesh, View, mesh_gallery};
-use amber_tasks::console::{ConsoleProblem, ConsoleSplit, INITIAL_MESH_RECIPE, TrainSet, has_test_split, part_names};
+use amber_tasks::WithExpert;
+use amber_tasks::console::{INITIAL_MESH_RECIPE, INITIAL_SIZE, TrainSet, check_data, has_test_split};
+use amber_tasks::folder::{DatasetSettings, Split, problems, read_experts};
+use amber_tasks::part::SolidPart;
 use amber_train::{MethodConfig, Profile};
 use anyhow::bail;
-use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::method::{Method, MethodSpec};
@@ -84,7 +86,8 @@ impl ConsoleExperiment {
         if self.methods.is_empty() || self.seeds == 0 {
             bail!("nothing to run: give at least one method and seed");
         }
-        let test_split = if has_test_split(&self.data) { ConsoleSplit::Test } else { ConsoleSplit::Val };
+        check_data(&self.data)?;
+        let test_split = if has_test_split(&self.data) { Split::Test } else { Split::Val };
         let test = self.load(test_split, usize::MAX)?;
         let test_name =
             evaluation_name(format!("console {} ({} parts)", test_split.name(), test.len()), self.scale_to_budget);
@@ -103,12 +106,9 @@ impl ConsoleExperiment {
                 }
                 let evaluated = run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| {
                     let problems = |validates: bool| {
-                        let val = if validates {
-                            self.load(ConsoleSplit::Val, config.data().val_problems)?
-                        } else {
-                            Vec::new()
-                        };
-                        Ok((self.load(ConsoleSplit::Train, config.data().train_problems)?, val))
+                        let val =
+                            if validates { self.load(Split::Val, config.data().val_problems)? } else { Vec::new() };
+                        Ok((self.load(Split::Train, config.data().train_problems)?, val))
                     };
                     train_run(&config, problems, dir, label)
                 })?;
@@ -134,12 +134,16 @@ impl ConsoleExperiment {
         Ok(results)
     }
 
-    /// The first `count` parts of a split (all of them for `usize::MAX`), loaded in parallel
-    /// (their initial meshes are generated on loading).
-    fn load(&self, split: ConsoleSplit, count: usize) -> anyhow::Result<Vec<ConsoleProblem>> {
-        let mut names = part_names(&self.data, split, self.train_set)?;
-        names.truncate(count);
-        Ok(names.par_iter().map(|stem| ConsoleProblem::load(&self.data, split, stem)).collect::<Result<_, _>>()?)
+    /// The first `count` parts of a split (all of them for `usize::MAX`; of the training split,
+    /// at most those of the train set), loaded through the folder loader in parallel with M⁰ at
+    /// the spec's h₀.
+    fn load(&self, split: Split, count: usize) -> anyhow::Result<Vec<WithExpert<SolidPart, 3>>> {
+        let limit = match split {
+            Split::Train => self.train_set.part_limit().map_or(count, |parts| parts.min(count)),
+            Split::Val | Split::Test => count,
+        };
+        let experts = read_experts::<3>(&split.dir(&self.data), Some(limit))?;
+        Ok(problems(experts, INITIAL_SIZE, &DatasetSettings::read(&self.data)?)?)
     }
 }
 

@@ -8,6 +8,7 @@
 
 mod card;
 mod console;
+mod folder;
 mod method;
 mod outputs;
 mod poisson;
@@ -20,6 +21,7 @@ mod table;
 
 pub use card::{CARD_FILE, CardEvaluation, ModelCard, resolve_model};
 pub use console::ConsoleExperiment;
+pub use folder::{FolderTraining, train_folder};
 pub use method::{Method, MethodSpec, Variant};
 pub use poisson::{PoissonExperiment, train_poisson};
 pub use profiles::{Task, amber_config, cnn_config};

@@ -4,13 +4,14 @@
 //! and the user's overrides are merged on top (see [`crate::MethodSpec`]). Why each value is what
 //! it is: docs/PROFILES.md.
 
+use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
 use amber_train::{CnnConfig, MethodConfig, Profile, TrainingConfig};
 
 use crate::{Method, MethodSpec};
 use serde::{Deserialize, Serialize};
 
-/// A learning task of the paper.
+/// A learning task: the paper's two, or a dataset folder.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Task {
@@ -18,6 +19,9 @@ pub enum Task {
     Poisson,
     /// The 3D Console car-seat parts (spec §9).
     Console,
+    /// A folder of expert meshes (`amber train --data DIR`) of `dimension` 2 or 3: geometric
+    /// inputs only, meshed as planar or solid parts.
+    Folder { dimension: usize },
 }
 
 /// AMBER's configuration of `task` under `profile` (before the method's labels and the seed).
@@ -37,6 +41,13 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
                 // A batch is at least one whole part (1.4k–42k elements): fewer, slower steps.
                 config.steps = 1_200;
                 config.validation_interval = 400;
+            }
+        }
+        // Geometry is all a folder offers; log h(K) is the generic input every profile but the
+        // paper's already reads.
+        (Task::Folder { .. }, _) => {
+            if !config.inputs.iter().any(|i| i == LOG_SIZE_COLUMN) {
+                config.inputs.push(LOG_SIZE_COLUMN.into());
             }
         }
     }
@@ -97,7 +108,7 @@ mod tests {
 
     #[test]
     fn every_task_and_profile_gives_a_valid_config() {
-        for task in [Task::Poisson, Task::Console] {
+        for task in [Task::Poisson, Task::Console, Task::Folder { dimension: 2 }] {
             for profile in Profile::ALL {
                 amber_config(task, profile).validate().unwrap();
                 cnn_config(task, profile, 32).validate().unwrap();
@@ -106,5 +117,9 @@ mod tests {
         assert!(amber_config(Task::Poisson, Profile::Quick).inputs.iter().any(|i| i == LOG_ERROR_INDICATOR_COLUMN));
         assert!(amber_config(Task::Console, Profile::Quick).inputs.iter().all(|i| i != LOG_ERROR_INDICATOR_COLUMN));
         assert!(amber_config(Task::Poisson, Profile::Paper).inputs.is_empty());
+        for profile in Profile::ALL {
+            let inputs = amber_config(Task::Folder { dimension: 3 }, profile).inputs;
+            assert_eq!(inputs, [LOG_SIZE_COLUMN], "{profile:?}");
+        }
     }
 }

@@ -26,6 +26,13 @@ pub enum TaskError {
     /// A geometry file does not describe a domain (the message says why).
     #[error("{path}: {message}")]
     Geometry { path: PathBuf, message: String },
+    /// An expert mesh of a dataset folder could not be read (the error names the file).
+    #[error("expert mesh {0}")]
+    ExpertMesh(MeshError),
+    /// A dataset folder is malformed: a missing or empty split, mixed dimensions, a geometry that
+    /// does not match its mesh (the message says which).
+    #[error("{path}: {message}")]
+    Dataset { path: PathBuf, message: String },
     /// A dataset manifest does not define what was asked.
     #[error("{path}: {message}")]
     Manifest { path: PathBuf, message: String },

@@ -2,16 +2,19 @@
 //! domain, re-meshing from a sizing field; [`Problem`]: a domain with its expert mesh), what every
 //! task shares (mesh states with their graphs, labels, one generation step under h_min and the
 //! element budget, meshing to a requested element count), geometry-only domains
-//! ([`part::SolidPart`]), and the tasks themselves beside their data. Poisson (spec §1): the random L-shape and Gaussian-mixture load,
-//! M⁰, the expert mesh, one JSON file per problem (readable from the reference's format too),
-//! the dataset splits of `datasets/poisson.json` with a content-hash cache. Console (spec §9): the
-//! expert `.nas` meshes and reference surfaces of the car-seat parts.
+//! ([`part::SolidPart`], [`part::PlanarPart`]), datasets as folders of expert meshes
+//! ([`folder`]), and the tasks themselves beside their data. Poisson (spec §1): the random
+//! L-shape and Gaussian-mixture load, M⁰, the expert mesh, one JSON file per problem (readable
+//! from the reference's format too), the dataset splits of `datasets/poisson.json` with a
+//! content-hash cache. Console (spec §9): a dataset folder; its module keeps the paper's M⁰ size
+//! and split.
 //!
 //! Depends on the mesh, meshing, FEM, graph and metric layers; knows nothing of networks,
 //! training loops or candle, and never prints (progress is reported through a callback).
 
 pub mod console;
 mod error;
+pub mod folder;
 pub mod part;
 pub mod poisson;
 mod problem;

@@ -1,13 +1,17 @@
-//! Geometry-only domains: a solid bounded by a validated, CAD-face-labelled surface, with no
-//! task inputs beyond the geometry of its meshes. A geometry-only model (Console's) meshes any
-//! [`SolidPart`]; every Console problem is one with its expert's mesh.
+//! Geometry-only domains, with no task inputs beyond the geometry of their meshes: a solid
+//! bounded by a validated, CAD-face-labelled surface ([`SolidPart`]) and a planar polygon with
+//! holes ([`PlanarPart`]). A geometry-only model (Console's, or one trained on a folder of expert
+//! meshes) meshes any part of its dimension; every problem of a folder dataset is one with its
+//! expert's mesh.
 
 use std::path::Path;
 
 use amber_graph::FeatureSet;
-use amber_mesh::{AnyMesh, Mesh, Mesh3, StlFaceIds, read_any_mesh, read_surface};
+use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, StlFaceIds, read_any_mesh, read_surface};
 use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, Surface, generate_3d};
-use amber_meshgen::{ConstantSize, MeshSizing, MeshgenError, PolygonDomain};
+use amber_meshgen::{
+    ConstantSize, Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, generate_2d, uniform_mesh_2d,
+};
 
 use crate::TaskError;
 use crate::problem::{Column, Domain, ProblemError};
@@ -25,22 +29,36 @@ pub const FEATURE_ANGLE_DEGREES: f64 = 30.0;
 pub fn read_solid_surface(path: &Path, feature_angle: f64) -> Result<Surface, TaskError> {
     let geometry = |message: String| TaskError::Geometry { path: path.into(), message };
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let mut surface = match extension.as_deref() {
+    match extension.as_deref() {
         Some("stl" | "obj") => {
             let soup = read_surface(path, StlFaceIds::FromFile).map_err(|e| geometry(e.to_string()))?;
-            Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(|e| geometry(e.to_string()))?
+            let surface =
+                Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(|e| geometry(e.to_string()))?;
+            validated_solid(path, surface, feature_angle)
         }
         _ => match read_any_mesh(path).map_err(|e| geometry(format!("neither a surface nor a tet mesh: {e}")))? {
-            AnyMesh::Three(mesh, _) => {
-                Surface::from_mesh_boundary(&mesh).map_err(|e| geometry(format!("boundary of the tet mesh: {e}")))?
-            }
-            AnyMesh::Two(..) => return Err(geometry("holds triangles (a 2D geometry), not a solid".into())),
+            AnyMesh::Three(mesh, _) => solid_surface_of_mesh(path, &mesh, feature_angle),
+            AnyMesh::Two(..) => Err(geometry("holds triangles (a 2D geometry), not a solid".into())),
         },
-    };
+    }
+}
+
+/// The boundary of the tet mesh `mesh` (read from `path`) as a validated surface, split into
+/// faces at edges sharper than `feature_angle` degrees.
+pub(crate) fn solid_surface_of_mesh(path: &Path, mesh: &Mesh3, feature_angle: f64) -> Result<Surface, TaskError> {
+    let surface = Surface::from_mesh_boundary(mesh)
+        .map_err(|e| TaskError::Geometry { path: path.into(), message: format!("boundary of the tet mesh: {e}") })?;
+    validated_solid(path, surface, feature_angle)
+}
+
+/// `surface` (from `path`) split at feature edges when it has a single face, and validated.
+fn validated_solid(path: &Path, mut surface: Surface, feature_angle: f64) -> Result<Surface, TaskError> {
     if surface.face_ids().iter().all(|&id| id == surface.face_ids()[0]) {
         surface.split_faces_at_feature_edges(feature_angle);
     }
-    surface.validate().map_err(|e| geometry(format!("does not bound a solid: {e}")))?;
+    surface
+        .validate()
+        .map_err(|e| TaskError::Geometry { path: path.into(), message: format!("does not bound a solid: {e}") })?;
     Ok(surface)
 }
 
@@ -58,11 +76,15 @@ pub fn read_polygon_domain(path: &Path) -> Result<PolygonDomain, TaskError> {
         }
     }
     match read_any_mesh(path).map_err(|e| geometry(format!("neither a polygon nor a triangle mesh: {e}")))? {
-        AnyMesh::Two(mesh, _) => {
-            PolygonDomain::from_mesh_boundary(&mesh).map_err(|e| geometry(format!("boundary of the mesh: {e}")))
-        }
+        AnyMesh::Two(mesh, _) => polygon_domain_of_mesh(path, &mesh),
         AnyMesh::Three(..) => Err(geometry("holds tetrahedra (a 3D geometry), not a planar domain".into())),
     }
+}
+
+/// The domain the triangle mesh `mesh` (read from `path`) covers.
+pub(crate) fn polygon_domain_of_mesh(path: &Path, mesh: &Mesh2) -> Result<PolygonDomain, TaskError> {
+    PolygonDomain::from_mesh_boundary(mesh)
+        .map_err(|e| TaskError::Geometry { path: path.into(), message: format!("boundary of the mesh: {e}") })
 }
 
 /// A solid to mesh: its bounding surface and M⁰.
@@ -105,5 +127,45 @@ impl Domain<3> for SolidPart {
         let params = Mesh3dParams::default().with_max_elements(max_elements);
         generate_3d(&self.surface, &MeshSizing::new(mesh, sizes), &params)
             .map_err(|e| ProblemError::Meshing(MeshgenError::from(e)))
+    }
+}
+
+/// A planar domain to mesh: its polygon with holes and M⁰, meshed by the 2D generator.
+#[derive(Clone, Debug)]
+pub struct PlanarPart {
+    /// What errors and reports call it (e.g. `split/stem` of a folder dataset).
+    pub name: String,
+    /// The polygon with holes every new mesh is made of.
+    pub domain: PolygonDomain,
+    /// M⁰: a uniform mesh of the domain.
+    pub initial_mesh: Mesh2,
+}
+
+impl PlanarPart {
+    /// Meshes M⁰ uniformly with size `initial_size`.
+    pub fn new(name: String, domain: PolygonDomain, initial_size: f64) -> Result<Self, MeshgenError> {
+        let initial_mesh = uniform_mesh_2d(&domain, initial_size, &Mesh2dParams::default())?;
+        Ok(Self { name, domain, initial_mesh })
+    }
+}
+
+impl Domain<2> for PlanarPart {
+    /// Geometric features only: node [area], edge [2D midpoint difference].
+    fn feature_set(&self) -> FeatureSet {
+        FeatureSet::console()
+    }
+
+    fn initial_mesh(&self) -> &Mesh<2> {
+        &self.initial_mesh
+    }
+
+    /// None: the features are geometric, computed by the graph.
+    fn columns(&self, _mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
+        Ok(Vec::new())
+    }
+
+    fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
+        let params = Mesh2dParams::default().with_max_elements(max_elements);
+        Ok(generate_2d(&self.domain, &MeshSizing::new(mesh, sizes), &params)?)
     }
 }

@@ -301,34 +301,10 @@ pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
 
 #[cfg(test)]
 mod tests {
-    use amber_meshgen::{Mesh2dParams, MeshSizing, PolygonDomain, generate_2d, uniform_mesh_2d};
+    use amber_meshgen::PolygonDomain;
 
     use super::*;
-
-    /// The unit square with a hole, no inputs.
-    struct Holed {
-        domain: PolygonDomain,
-        initial_mesh: Mesh<2>,
-    }
-
-    impl Domain<2> for Holed {
-        fn feature_set(&self) -> FeatureSet {
-            FeatureSet::console()
-        }
-
-        fn initial_mesh(&self) -> &Mesh<2> {
-            &self.initial_mesh
-        }
-
-        fn columns(&self, _: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-            Ok(Vec::new())
-        }
-
-        fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
-            let params = Mesh2dParams::default().with_max_elements(max_elements);
-            Ok(generate_2d(&self.domain, &MeshSizing::new(mesh, sizes), &params)?)
-        }
-    }
+    use crate::part::PlanarPart;
 
     /// A field graded by a factor of 20 towards one corner, asked for 0.25×, 1× and 4× its own
     /// count: every mesh lands within the tolerance, keeps the grading, and covers the domain.
@@ -336,8 +312,7 @@ mod tests {
     fn meshes_reach_the_requested_element_count() {
         let hole = vec![[0.4, 0.4], [0.4, 0.6], [0.6, 0.6], [0.6, 0.4]];
         let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![hole]).unwrap();
-        let initial_mesh = uniform_mesh_2d(&domain, 0.1, &Mesh2dParams::default()).unwrap();
-        let holed = Holed { domain, initial_mesh };
+        let holed = PlanarPart::new("holed".into(), domain, 0.1).unwrap();
         let mesh = holed.initial_mesh();
         let sizes: Vec<f64> = mesh.midpoints().iter().map(|x| 0.004 + 0.08 * (x[0] + x[1]) / 2.0).collect();
         let natural = holed.remesh(mesh, sizes.clone(), 1_000_000).unwrap().num_elements();

@@ -8,21 +8,18 @@
 //! DIR/reference_surface/train/001.stl  …
 //! ```
 //!
-//! [`load_split`] reads one split into [`ConsoleProblem`]s: the expert mesh M*, the validated
-//! reference surface, and M⁰, a uniform mesh of element volume 10 mm³ made by the 3D generator.
-//! The paper trains on train/001–015, validates on val/001–002 and tests on test/001–005;
-//! [`TrainSet::All`] trains on all 19.
-
-mod problem;
+//! This is a dataset folder (see [`crate::folder`]) whose geometry lies under
+//! `reference_surface/`: it loads as any other, each part a [`SolidPart`](crate::part::SolidPart)
+//! with its expert mesh and M⁰ a uniform mesh of element volume 10 mm³ ([`INITIAL_SIZE`]). What
+//! is Console's own is here: that size, the paper's split (train on train/001–015, validate on
+//! val/001–002, test on test/001–005; [`TrainSet::All`] trains on all 19) and where to get the
+//! data.
 
 use std::path::{Path, PathBuf};
 
-use amber_mesh::{Mesh3, MeshError, read_mesh};
-use amber_meshgen::mesh3d::{Mesh3dError, StlFaceIds, Surface, SurfaceError};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::part::SolidPart;
+use crate::folder::{GEOMETRY_DIR, Split};
 
 /// Element volume of M⁰ in mm³ (spec §9).
 pub const INITIAL_ELEMENT_VOLUME: f64 = 10.0;
@@ -46,26 +43,6 @@ const HOW_TO_GET_THE_DATA: &str = "download the Console data (MIT licence) of th
      datasets/console/make_reference_surfaces.py DIR` (OpenCASCADE, MeshSizeFromCurvature=48, MeshSizeMax=2.5 mm, \
      MeshSizeExtendFromBoundary=0, Mesh.Algorithm=6; see datasets/console/README.md)";
 
-/// A split of the Console data.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ConsoleSplit {
-    Train,
-    Val,
-    Test,
-}
-
-impl ConsoleSplit {
-    /// The directory name (`train`, `val`, `test`).
-    pub fn name(self) -> &'static str {
-        match self {
-            ConsoleSplit::Train => "train",
-            ConsoleSplit::Val => "val",
-            ConsoleSplit::Test => "test",
-        }
-    }
-}
-
 /// Which training parts to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -80,103 +57,47 @@ pub enum TrainSet {
 /// Number of training parts of the paper's split.
 const PAPER_TRAIN_PARTS: usize = 15;
 
-/// Reading the Console data failed.
+impl TrainSet {
+    /// How many training parts (the first, by name) the set takes; `None`: all.
+    pub fn part_limit(self) -> Option<usize> {
+        match self {
+            TrainSet::Paper => Some(PAPER_TRAIN_PARTS),
+            TrainSet::All => None,
+        }
+    }
+}
+
+/// The Console data is absent (or lacks its reference surfaces).
 #[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum ConsoleError {
-    /// The data directory or one of its splits is absent.
-    #[error("{path}: Console data not found; {HOW_TO_GET_THE_DATA}")]
-    Missing { path: PathBuf },
-    /// A part has its expert mesh but no reference surface.
-    #[error("{path}: reference surface not found (for {step}); {HOW_TO_GET_THE_DATA}")]
-    MissingReference { path: PathBuf, step: PathBuf },
-    /// A directory could not be listed.
-    #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
-    /// The training split has fewer parts than the paper's split uses.
-    #[error("{path}: the paper's split trains on {expected} parts, found {found}")]
-    TooFewParts { path: PathBuf, expected: usize, found: usize },
-    /// An expert mesh could not be read.
-    #[error("expert mesh: {0}")]
-    Expert(#[from] MeshError),
-    /// A reference surface could not be read or does not bound a solid.
-    #[error("reference surface: {0}")]
-    Reference(#[from] SurfaceError),
-    /// The uniform initial mesh could not be generated.
-    #[error("{name}: initial mesh: {source}")]
-    InitialMesh { name: String, source: Mesh3dError },
+#[error("{path}: Console data not found; {HOW_TO_GET_THE_DATA}")]
+pub struct MissingData {
+    pub path: PathBuf,
 }
 
-/// One Console part with its expert's mesh.
-#[derive(Clone, Debug)]
-pub struct ConsoleProblem {
-    /// The part, named `split/NNN` (e.g. `train/001`): the validated reference surface (mm, CAD
-    /// face ids) and M⁰, the uniform mesh with h₀ = [`INITIAL_SIZE`].
-    pub part: SolidPart,
-    /// M*: the expert's mesh (mm).
-    pub expert_mesh: Mesh3,
-}
-
-impl ConsoleProblem {
-    /// Reads part `stem` (e.g. `001`) of `split` from the data directory `data` and makes M⁰.
-    pub fn load(data: &Path, split: ConsoleSplit, stem: &str) -> Result<Self, ConsoleError> {
-        let name = format!("{}/{stem}", split.name());
-        let nas = data.join(format!("{name}.nas"));
-        let stl = data.join("reference_surface").join(format!("{name}.stl"));
-        if !stl.is_file() {
-            return Err(ConsoleError::MissingReference { path: stl, step: nas.with_extension("step") });
-        }
-        let expert_mesh = read_mesh::<3>(&nas)?;
-        let (reference, _) = Surface::load(&stl, StlFaceIds::FromFile)?;
-        let part = SolidPart::new(name.clone(), reference, INITIAL_SIZE)
-            .map_err(|source| ConsoleError::InitialMesh { name, source })?;
-        Ok(Self { part, expert_mesh })
-    }
-}
-
-/// The parts of `split` as file stems (`001`, …), sorted; for the training split only the
-/// first 15 unless `train_set` is [`TrainSet::All`].
-pub fn part_names(data: &Path, split: ConsoleSplit, train_set: TrainSet) -> Result<Vec<String>, ConsoleError> {
-    let dir = data.join(split.name());
-    if !dir.is_dir() {
-        return Err(ConsoleError::Missing { path: dir });
-    }
-    let io = |source| ConsoleError::Io { path: dir.clone(), source };
-    let mut names = Vec::new();
-    for entry in std::fs::read_dir(&dir).map_err(io)? {
-        let path = entry.map_err(io)?.path();
-        if path.extension().is_some_and(|e| e == "nas")
-            && let Some(stem) = path.file_stem().and_then(|s| s.to_str())
-        {
-            names.push(stem.to_owned());
+/// Checks that `data` holds the Console data: the training split and the reference surfaces,
+/// without which the folder loader would fall back to the experts' own boundaries.
+pub fn check_data(data: &Path) -> Result<(), MissingData> {
+    for dir in [Split::Train.dir(data), data.join(GEOMETRY_DIR)] {
+        if !dir.is_dir() {
+            return Err(MissingData { path: dir });
         }
     }
-    names.sort();
-    if split == ConsoleSplit::Train && train_set == TrainSet::Paper {
-        if names.len() < PAPER_TRAIN_PARTS {
-            return Err(ConsoleError::TooFewParts { path: dir, expected: PAPER_TRAIN_PARTS, found: names.len() });
-        }
-        names.truncate(PAPER_TRAIN_PARTS);
-    }
-    Ok(names)
+    Ok(())
 }
 
 /// Whether `data` has a `test/` split (the shipped bundle has only `train/` and `val/`).
 pub fn has_test_split(data: &Path) -> bool {
-    data.join(ConsoleSplit::Test.name()).is_dir()
-}
-
-/// Reads every part of `split` (in parallel), in the order of [`part_names`].
-pub fn load_split(data: &Path, split: ConsoleSplit, train_set: TrainSet) -> Result<Vec<ConsoleProblem>, ConsoleError> {
-    if !data.is_dir() {
-        return Err(ConsoleError::Missing { path: data.to_owned() });
-    }
-    part_names(data, split, train_set)?.par_iter().map(|stem| ConsoleProblem::load(data, split, stem)).collect()
+    Split::Test.dir(data).is_dir()
 }
 
 #[cfg(test)]
 mod tests {
+    use amber_graph::Aggregation;
+
     use super::*;
+    use crate::folder::{DatasetSettings, problems, read_experts};
+    use crate::part::SolidPart;
+    use crate::problem::{Domain, MeshLimits, MeshState, Problem, StepOutcome, generation_step, labels};
 
     #[test]
     fn initial_size_is_the_regular_tet_of_ten_cubic_millimetres() {
@@ -185,9 +106,8 @@ mod tests {
 
     #[test]
     fn absent_data_says_what_to_download() {
-        let err = load_split(Path::new("/nonexistent/console"), ConsoleSplit::Train, TrainSet::Paper).unwrap_err();
+        let err = check_data(Path::new("/nonexistent/console")).unwrap_err();
         let message = err.to_string();
-        assert!(matches!(err, ConsoleError::Missing { .. }));
         for needle in ["/nonexistent/console", "MIT", "NiklasFreymuth/AMBER", "gmsh", "MeshSizeFromCurvature=48"] {
             assert!(message.contains(needle), "{needle} missing from: {message}");
         }
@@ -196,50 +116,57 @@ mod tests {
     #[test]
     fn shipped_splits_follow_the_paper() {
         let Some(data) = amber_testdata::shared("data/console") else { return };
-        let train = part_names(&data, ConsoleSplit::Train, TrainSet::Paper).unwrap();
+        check_data(&data).unwrap();
+        let train = read_experts::<3>(&Split::Train.dir(&data), TrainSet::Paper.part_limit()).unwrap();
         assert_eq!(train.len(), 15);
-        assert_eq!((train[0].as_str(), train[14].as_str()), ("001", "015"));
-        assert_eq!(part_names(&data, ConsoleSplit::Train, TrainSet::All).unwrap().len(), 19);
-        assert_eq!(part_names(&data, ConsoleSplit::Val, TrainSet::Paper).unwrap(), ["001", "002"]);
-        if !has_test_split(&data) {
-            assert!(matches!(
-                part_names(&data, ConsoleSplit::Test, TrainSet::Paper),
-                Err(ConsoleError::Missing { .. })
-            ));
-        }
+        assert_eq!((train[0].name.as_str(), train[14].name.as_str()), ("train/001", "train/015"));
+        assert!(train.iter().all(|e| e.geometry.as_ref().is_some_and(|g| g.starts_with(data.join(GEOMETRY_DIR)))));
+        assert_eq!(read_experts::<3>(&Split::Train.dir(&data), TrainSet::All.part_limit()).unwrap().len(), 19);
+        let val: Vec<String> =
+            read_experts::<3>(&Split::Val.dir(&data), None).unwrap().into_iter().map(|e| e.name).collect();
+        assert_eq!(val, ["val/001", "val/002"]);
     }
 
+    /// val/002 through the folder loader: its reference surface, a uniform M⁰, the expert; then
+    /// one generation step from M⁰ with a smoke-size field (3 mm everywhere): a new mesh of the
+    /// same solid with about the expected element count, its graph and labels; and a field far
+    /// too fine is stopped by the budget, not meshed.
     #[test]
-    fn shipped_part_loads_with_a_uniform_initial_mesh() {
+    fn a_shipped_part_loads_through_the_folder_and_takes_a_step() {
         let Some(data) = amber_testdata::shared("data/console") else { return };
         let start = std::time::Instant::now();
-        let problem = ConsoleProblem::load(&data, ConsoleSplit::Val, "002").unwrap();
-        let (m0, expert) = (&problem.part.initial_mesh, &problem.expert_mesh);
+        let mut experts = read_experts::<3>(&Split::Val.dir(&data), None).unwrap();
+        let expert = experts.pop().unwrap();
+        let mut loaded = problems::<3, SolidPart>(vec![expert], INITIAL_SIZE, &DatasetSettings::default()).unwrap();
+        let problem = loaded.pop().unwrap();
+        let (m0, expert) = (problem.initial_mesh(), problem.expert_mesh());
         println!(
             "{}: expert {} tets, M⁰ {} tets, {:.2} s",
-            problem.part.name,
+            problem.domain.name,
             expert.num_elements(),
             m0.num_elements(),
             start.elapsed().as_secs_f64()
         );
-        assert_eq!(problem.part.name, "val/002");
+        assert_eq!(problem.domain.name, "val/002");
         assert_eq!(expert.num_elements(), 17489);
         // M⁰ fills the same solid, with elements far coarser than the expert's.
-        let volume = problem.part.surface.enclosed_volume();
+        let volume = problem.domain.surface.enclosed_volume();
         assert!((m0.total_volume() / volume - 1.0).abs() < 5e-3 && (expert.total_volume() / volume - 1.0).abs() < 5e-3);
         assert!((500..6_000).contains(&m0.num_elements()), "{} tets", m0.num_elements());
-        assert!(problem.part.surface.is_validated());
-    }
+        assert!(problem.domain.surface.is_validated());
 
-    #[test]
-    fn a_missing_reference_surface_says_how_to_make_it() {
-        let Some(data) = amber_testdata::shared("data/console") else { return };
-        let dir = std::env::temp_dir().join(format!("amber-console-test-{}", std::process::id()));
-        std::fs::create_dir_all(dir.join("val")).unwrap();
-        std::fs::copy(data.join("val/002.nas"), dir.join("val/002.nas")).unwrap();
-        let err = load_split(&dir, ConsoleSplit::Val, TrainSet::Paper).unwrap_err();
-        std::fs::remove_dir_all(&dir).unwrap();
-        assert!(matches!(err, ConsoleError::MissingReference { .. }), "{err}");
-        assert!(err.to_string().contains("make_reference_surfaces.py"), "{err}");
+        let limits = MeshLimits::from_experts([problem.expert_mesh()], 1.2, 0.005);
+        let StepOutcome::Meshed(mesh) = generation_step(&problem, m0, vec![3.0; m0.num_elements()], &limits) else {
+            panic!("the 3 mm step was not meshed")
+        };
+        let expected = volume / amber_mesh::volume_from_size::<3>(3.0);
+        assert!((mesh.total_volume() / volume - 1.0).abs() < 5e-3);
+        assert!((0.5 * expected..3.0 * expected).contains(&(mesh.num_elements() as f64)));
+        let state = MeshState::new(&problem, &problem.feature_set(), mesh).unwrap();
+        assert_eq!(state.graph.num_nodes(), state.mesh.num_elements());
+        let y = labels(&problem, &state.mesh, Aggregation::Mean).unwrap();
+        assert!(y.len() == state.mesh.num_elements() && y.iter().all(|h| h.is_finite() && *h > 0.0));
+        let outcome = generation_step(&problem, m0, vec![0.05; m0.num_elements()], &limits);
+        assert!(matches!(outcome, StepOutcome::OverBudget { .. }), "{outcome:?}");
     }
 }

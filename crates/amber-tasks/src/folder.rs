@@ -1,0 +1,448 @@
+//! A dataset is a folder of expert meshes: what a team that adopts AMBER has, and what both paper
+//! tasks' real data (Console) is an instance of.
+//!
+//! ```text
+//! DIR/dataset.json                       optional: settings a folder cannot say (DatasetSettings)
+//! DIR/train/<stem>.<mesh>                one expert mesh per part, any format amber reads
+//! DIR/train/<stem>.stl|.obj|.json        optional geometry beside it (3D surface, 2D polygon)
+//! DIR/val/…  [DIR/test/…]
+//! DIR/reference_surface/<split>/<stem>.stl|.obj|.json   the geometry, when not beside the mesh
+//! ```
+//!
+//! A file is an expert mesh when `amber_mesh::read_mesh` reads its extension (a `.json` beside a
+//! mesh of the same stem is that mesh's polygon instead); other files (`.step`, notes) are
+//! ignored. The dimension comes from the files (tets: 3D, triangles: 2D). Without a geometry
+//! file, the expert mesh's own boundary is the geometry. A part is a [`FolderDomain`]:
+//! [`SolidPart`] in 3D, [`PlanarPart`] in 2D, with M⁰ a uniform mesh of one size for the whole
+//! dataset.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use amber_mesh::{Mesh, MeshError, read_mesh};
+use amber_stdx::{median, read_json};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::TaskError;
+use crate::part::{
+    FEATURE_ANGLE_DEGREES, PlanarPart, SolidPart, polygon_domain_of_mesh, read_polygon_domain, read_solid_surface,
+    solid_surface_of_mesh,
+};
+use crate::problem::{Domain, WithExpert};
+
+/// The optional settings file in a dataset's root.
+pub const SETTINGS_FILE: &str = "dataset.json";
+
+/// The folder of geometry files beside the splits (the layout of the AMBER authors' Console
+/// bundle): `<GEOMETRY_DIR>/<split>/<stem>.stl`.
+pub const GEOMETRY_DIR: &str = "reference_surface";
+
+/// The default M⁰ size is this many times the median element size of the training experts: M⁰
+/// must be coarser than the expert almost everywhere (the network learns to refine, and the
+/// normalised DCD measures progress from M⁰), yet fine enough to resolve the part's shape. On
+/// Console's 15 paper training parts (median expert size 1.23 mm) the rule gives 4.92 mm, near
+/// the spec's h₀ = 4.3955 mm, which the Console experiment passes explicitly.
+pub const INITIAL_SIZE_FACTOR: f64 = 4.0;
+
+/// Geometry and mesh may enclose volumes (areas) differing by this fraction: a geometry file of
+/// another part, or in other units, differs by far more; a faceted CAD surface and its mesh by
+/// far less.
+const VOLUME_TOLERANCE: f64 = 0.01;
+
+/// A split of a dataset folder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Split {
+    Train,
+    Val,
+    Test,
+}
+
+impl Split {
+    /// The directory name (`train`, `val`, `test`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Train => "train",
+            Split::Val => "val",
+            Split::Test => "test",
+        }
+    }
+
+    /// The directory of this split in the dataset `root`.
+    pub fn dir(self, root: &Path) -> PathBuf {
+        root.join(self.name())
+    }
+}
+
+/// What `dataset.json` may set; every field is optional.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DatasetSettings {
+    /// Edge length of the uniform M⁰ of every part, in the meshes' units (default:
+    /// [`INITIAL_SIZE_FACTOR`] × the median training expert element size).
+    pub initial_size: Option<f64>,
+    /// Surfaces without CAD faces (a plain STL, a mesh boundary) are split into faces at edges
+    /// sharper than this many degrees (default [`FEATURE_ANGLE_DEGREES`]).
+    pub feature_angle: Option<f64>,
+}
+
+impl DatasetSettings {
+    /// The settings of the dataset in `root`: its `dataset.json`, or the defaults without one.
+    pub fn read(root: &Path) -> Result<Self, TaskError> {
+        let path = root.join(SETTINGS_FILE);
+        if !path.is_file() {
+            return Ok(Self::default());
+        }
+        let settings: Self =
+            read_json(&path).map_err(|e| TaskError::Dataset { path: path.clone(), message: e.to_string() })?;
+        let positive = |value: Option<f64>| value.is_none_or(|v| v.is_finite() && v > 0.0);
+        if !positive(settings.initial_size) || !positive(settings.feature_angle) {
+            return Err(TaskError::Dataset { path, message: "initial_size and feature_angle must be positive".into() });
+        }
+        Ok(settings)
+    }
+
+    /// The feature angle in degrees.
+    pub fn feature_angle(&self) -> f64 {
+        self.feature_angle.unwrap_or(FEATURE_ANGLE_DEGREES)
+    }
+}
+
+/// One part of a split as read: its expert mesh and where its geometry is, if anywhere.
+#[derive(Clone, Debug)]
+pub struct Expert<const D: usize> {
+    /// `split/stem`, e.g. `train/001`.
+    pub name: String,
+    /// The expert mesh's file.
+    pub path: PathBuf,
+    pub mesh: Mesh<D>,
+    /// The geometry file (beside the mesh or under [`GEOMETRY_DIR`]); `None`: the mesh's boundary.
+    pub geometry: Option<PathBuf>,
+}
+
+/// Whether `path` is a geometry file of a `D`-dimensional part (surfaces in 3D, polygons in 2D).
+fn geometry_extensions(dimension: usize) -> &'static [&'static str] {
+    if dimension == 3 { &["stl", "obj"] } else { &["json"] }
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default()
+}
+
+/// The candidate expert meshes of the split directory `dir`, by stem (sorted): every file but
+/// surfaces, and a `.json` only when its stem has no other candidate. Surfaces and polygons
+/// beside the mesh are kept per stem for [`find_geometry`]. An absent or empty directory is an
+/// error naming it.
+fn part_files(dir: &Path) -> Result<BTreeMap<String, Vec<PathBuf>>, TaskError> {
+    if !dir.is_dir() {
+        return Err(TaskError::Dataset { path: dir.into(), message: "split directory not found".into() });
+    }
+    let io = |source| TaskError::Io { path: dir.into(), source };
+    let mut by_stem: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        let path = entry.map_err(io)?.path();
+        if let (true, Some(stem)) = (path.is_file(), path.file_stem().and_then(|s| s.to_str())) {
+            by_stem.entry(stem.to_owned()).or_default().push(path);
+        }
+    }
+    by_stem.values_mut().for_each(|files| files.sort());
+    Ok(by_stem)
+}
+
+/// Reads the expert mesh among `files` (one stem's files): the file `read_mesh` reads, a `.json`
+/// only when no other file is a mesh. `Ok(None)`: no file of the stem is a mesh.
+fn read_part_mesh<const D: usize>(files: &[PathBuf]) -> Result<Option<(PathBuf, Mesh<D>)>, TaskError> {
+    let (json, others): (Vec<&PathBuf>, Vec<&PathBuf>) = files.iter().partition(|p| extension(p) == "json");
+    let mut found: Option<(PathBuf, Mesh<D>)> = None;
+    for path in others.into_iter().chain(json) {
+        if found.is_some() && extension(path) == "json" {
+            continue;
+        }
+        let mesh = match read_mesh::<D>(path) {
+            Ok(mesh) => mesh,
+            Err(MeshError::UnsupportedFormat { .. }) => continue,
+            Err(MeshError::DimensionMismatch { found: other, .. }) => {
+                return Err(TaskError::Dataset {
+                    path: path.clone(),
+                    message: format!("holds a {other}D mesh, but the dataset is {D}D: mixed dimensions"),
+                });
+            }
+            Err(e) => return Err(TaskError::ExpertMesh(e)),
+        };
+        if let Some((first, _)) = &found {
+            return Err(TaskError::Dataset {
+                path: path.clone(),
+                message: format!("a second expert mesh of the part (the first is {})", first.display()),
+            });
+        }
+        found = Some((path.clone(), mesh));
+    }
+    Ok(found)
+}
+
+/// The geometry file of part `stem` of the split `dir`: beside the mesh, else under
+/// `<root>/reference_surface/<split>/`.
+fn find_geometry(dir: &Path, stem: &str, files: &[PathBuf], mesh: &Path, dimension: usize) -> Option<PathBuf> {
+    let extensions = geometry_extensions(dimension);
+    if let Some(beside) = files.iter().find(|p| p.as_path() != mesh && extensions.contains(&extension(p).as_str())) {
+        return Some(beside.clone());
+    }
+    let (root, split) = (dir.parent()?, dir.file_name()?);
+    extensions.iter().map(|e| root.join(GEOMETRY_DIR).join(split).join(format!("{stem}.{e}"))).find(|p| p.is_file())
+}
+
+/// The dimension of the meshes in the split directory `dir`: that of its first expert mesh (the
+/// others must match when read).
+pub fn mesh_dimension(dir: &Path) -> Result<usize, TaskError> {
+    for files in part_files(dir)?.values() {
+        let (json, others): (Vec<&PathBuf>, Vec<&PathBuf>) = files.iter().partition(|p| extension(p) == "json");
+        for path in others.into_iter().chain(json) {
+            match read_mesh::<3>(path) {
+                Ok(_) => return Ok(3),
+                Err(MeshError::DimensionMismatch { found, .. }) => return Ok(found),
+                Err(MeshError::UnsupportedFormat { .. }) => {}
+                Err(e) => return Err(TaskError::ExpertMesh(e)),
+            }
+        }
+    }
+    Err(TaskError::Dataset { path: dir.into(), message: "no expert mesh in this split".into() })
+}
+
+/// Reads the expert meshes of the split directory `dir` (at most `limit` parts, the first by
+/// stem), in parallel, and finds their geometry files. Every file that holds a mesh must be
+/// `D`-dimensional; a directory without a mesh is an error.
+pub fn read_experts<const D: usize>(dir: &Path, limit: Option<usize>) -> Result<Vec<Expert<D>>, TaskError> {
+    let split = dir.file_name().map_or_else(|| dir.display().to_string(), |s| s.to_string_lossy().into_owned());
+    let stems: Vec<(String, Vec<PathBuf>)> = part_files(dir)?.into_iter().collect();
+    let limit = limit.unwrap_or(usize::MAX);
+    let mut experts: Vec<Expert<D>> = Vec::new();
+    let mut next = 0;
+    // Batches of as many stems as parts are still wanted, read in parallel: a stem whose files
+    // hold no mesh (a lone `.step`) makes the next batch take the one after.
+    while experts.len() < limit && next < stems.len() {
+        let batch = &stems[next..stems.len().min(next.saturating_add(limit - experts.len()))];
+        next += batch.len();
+        let read: Vec<Option<Expert<D>>> = batch
+            .par_iter()
+            .map(|(stem, files)| {
+                Ok(read_part_mesh::<D>(files)?.map(|(path, mesh)| {
+                    let geometry = find_geometry(dir, stem, files, &path, D);
+                    Expert { name: format!("{split}/{stem}"), path, mesh, geometry }
+                }))
+            })
+            .collect::<Result<_, TaskError>>()?;
+        experts.extend(read.into_iter().flatten());
+    }
+    if experts.is_empty() {
+        return Err(TaskError::Dataset { path: dir.into(), message: "no expert mesh in this split".into() });
+    }
+    Ok(experts)
+}
+
+/// The default M⁰ size of a dataset: [`INITIAL_SIZE_FACTOR`] × the median element size of its
+/// training experts.
+pub fn default_initial_size<const D: usize>(train: &[Expert<D>]) -> f64 {
+    let sizes: Vec<f64> = train.iter().flat_map(|e| e.mesh.sizes()).collect();
+    INITIAL_SIZE_FACTOR * median(&sizes)
+}
+
+/// A geometry-only domain that a folder dataset's part becomes.
+pub trait FolderDomain<const D: usize>: Domain<D> + Sized + Send {
+    /// The part of `expert`: its geometry file, or the expert mesh's boundary, checked against
+    /// the expert mesh, with a uniform M⁰ of size `initial_size`.
+    fn from_expert(expert: &Expert<D>, initial_size: f64, settings: &DatasetSettings) -> Result<Self, TaskError>;
+}
+
+/// The error of a geometry whose enclosed volume (area) differs from its expert mesh's.
+fn check_volume<const D: usize>(expert: &Expert<D>, geometry: f64) -> Result<(), TaskError> {
+    let mesh = expert.mesh.total_volume();
+    match &expert.geometry {
+        Some(path) if (geometry / mesh - 1.0).abs() > VOLUME_TOLERANCE => Err(TaskError::Dataset {
+            path: path.clone(),
+            message: format!(
+                "encloses {} {geometry:.6e}, but the expert mesh {} covers {mesh:.6e}: not the geometry of this mesh",
+                if D == 3 { "volume" } else { "area" },
+                expert.path.display()
+            ),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// The error of an M⁰ that could not be meshed.
+fn initial_mesh_error<const D: usize>(expert: &Expert<D>, error: impl std::fmt::Display) -> TaskError {
+    let path = expert.geometry.clone().unwrap_or_else(|| expert.path.clone());
+    TaskError::Dataset { path, message: format!("initial mesh M⁰: {error}") }
+}
+
+impl FolderDomain<3> for SolidPart {
+    fn from_expert(expert: &Expert<3>, initial_size: f64, settings: &DatasetSettings) -> Result<Self, TaskError> {
+        let surface = match &expert.geometry {
+            Some(path) => read_solid_surface(path, settings.feature_angle())?,
+            None => solid_surface_of_mesh(&expert.path, &expert.mesh, settings.feature_angle())?,
+        };
+        check_volume(expert, surface.enclosed_volume())?;
+        SolidPart::new(expert.name.clone(), surface, initial_size).map_err(|e| initial_mesh_error(expert, e))
+    }
+}
+
+impl FolderDomain<2> for PlanarPart {
+    fn from_expert(expert: &Expert<2>, initial_size: f64, _settings: &DatasetSettings) -> Result<Self, TaskError> {
+        let domain = match &expert.geometry {
+            Some(path) => read_polygon_domain(path)?,
+            None => polygon_domain_of_mesh(&expert.path, &expert.mesh)?,
+        };
+        check_volume(expert, domain.area())?;
+        PlanarPart::new(expert.name.clone(), domain, initial_size).map_err(|e| initial_mesh_error(expert, e))
+    }
+}
+
+/// The problems of `experts`: each part's domain (M⁰ of size `initial_size`, generated in
+/// parallel) with its expert mesh.
+pub fn problems<const D: usize, P: FolderDomain<D>>(
+    experts: Vec<Expert<D>>,
+    initial_size: f64,
+    settings: &DatasetSettings,
+) -> Result<Vec<WithExpert<P, D>>, TaskError> {
+    experts
+        .into_par_iter()
+        .map(|expert| {
+            let domain = P::from_expert(&expert, initial_size, settings)?;
+            Ok(WithExpert { domain, expert_mesh: expert.mesh })
+        })
+        .collect()
+}
+
+/// Parts of each split of [`write_demo_dataset`].
+const DEMO_PARTS: [(Split, usize); 3] = [(Split::Train, 3), (Split::Val, 1), (Split::Test, 2)];
+
+/// Writes a small 2D dataset folder into `dir`, made by the project's own generator so that
+/// tests (and a new user) can train and evaluate a folder dataset end to end in seconds: plates
+/// (1.2–1.8 × 1) with one or two square holes (seeded), each meshed by `generate_2d` with a known
+/// sizing rule (0.02 at a hole's boundary growing linearly to 0.15 at 0.3 away) and written as
+/// gmsh `.msh` experts with no geometry files.
+pub fn write_demo_dataset(dir: &Path, seed: u64) -> Result<(), TaskError> {
+    use amber_meshgen::{FnSize, Mesh2dParams, PolygonDomain, generate_2d};
+    use rand::{Rng, SeedableRng};
+
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    for (split, parts) in DEMO_PARTS {
+        let split_dir = split.dir(dir);
+        std::fs::create_dir_all(&split_dir).map_err(|source| TaskError::Io { path: split_dir.clone(), source })?;
+        for k in 0..parts {
+            let width = rng.random_range(1.2..1.8);
+            let holes: usize = rng.random_range(1..=2);
+            // Holes of half-width 0.1–0.15 centred in their own slice of the plate, so they never meet.
+            let squares: Vec<([f64; 2], f64)> = (0..holes)
+                .map(|i| {
+                    let slice = width / holes as f64;
+                    let x = slice * (i as f64 + rng.random_range(0.35..0.65));
+                    ([x, rng.random_range(0.35..0.65)], rng.random_range(0.1..0.15))
+                })
+                .collect();
+            let hole_rings =
+                squares.iter().map(|&([x, y], r)| vec![[x - r, y - r], [x - r, y + r], [x + r, y + r], [x + r, y - r]]);
+            let outer = vec![[0.0, 0.0], [width, 0.0], [width, 1.0], [0.0, 1.0]];
+            let path = split_dir.join(format!("plate{k:02}.msh"));
+            let geometry = |message: String| TaskError::Geometry { path: path.clone(), message };
+            let domain = PolygonDomain::new(outer, hole_rings.collect()).map_err(|e| geometry(e.to_string()))?;
+            let size = FnSize(|p: [f64; 2]| {
+                let distance = squares
+                    .iter()
+                    .map(|&([x, y], r)| {
+                        let (dx, dy) = (((p[0] - x).abs() - r).max(0.0), ((p[1] - y).abs() - r).max(0.0));
+                        dx.hypot(dy)
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                0.02 + 0.13 * (distance / 0.3).min(1.0)
+            });
+            let mesh = generate_2d(&domain, &size, &Mesh2dParams::default()).map_err(|e| geometry(e.to_string()))?;
+            amber_mesh::write_mesh(&mesh, &path, &amber_mesh::MeshData::default()).map_err(TaskError::ExpertMesh)?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::problem::Problem;
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("amber-folder-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    /// The demo dataset loads as 2D planar parts whose geometry is the experts' boundary, with the
+    /// default M⁰ size coarser than the experts; the same seed writes the same files.
+    #[test]
+    fn the_demo_dataset_loads_as_planar_parts() {
+        let dir = temp_dir("demo");
+        write_demo_dataset(&dir, 7).unwrap();
+        assert_eq!(mesh_dimension(&Split::Train.dir(&dir)).unwrap(), 2);
+        let train = read_experts::<2>(&Split::Train.dir(&dir), None).unwrap();
+        assert_eq!(train.len(), 3);
+        assert!(train.iter().all(|e| e.geometry.is_none()));
+        let h0 = default_initial_size(&train);
+        let settings = DatasetSettings::read(&dir).unwrap();
+        let parts = problems::<2, PlanarPart>(train, h0, &settings).unwrap();
+        for part in &parts {
+            let (m0, expert) = (part.initial_mesh(), part.expert_mesh());
+            assert!((m0.total_volume() / expert.total_volume() - 1.0).abs() < 1e-9, "{}", part.domain.name);
+            assert!(m0.num_elements() * 4 < expert.num_elements(), "{}: M⁰ {}", part.domain.name, m0.num_elements());
+        }
+        let again = temp_dir("demo-again");
+        write_demo_dataset(&again, 7).unwrap();
+        let bytes = |d: &Path| std::fs::read(Split::Test.dir(d).join("plate01.msh")).unwrap();
+        assert_eq!(bytes(&dir), bytes(&again));
+        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(&again).unwrap();
+    }
+
+    /// Malformed folders fail with one error naming the file or directory at fault.
+    #[test]
+    fn malformed_folders_name_the_file_at_fault() {
+        let dir = temp_dir("malformed");
+        write_demo_dataset(&dir, 3).unwrap();
+        let train = Split::Train.dir(&dir);
+        let message = |e: TaskError| e.to_string();
+
+        // A missing split, an empty split.
+        let err = message(read_experts::<2>(&dir.join("missing"), None).unwrap_err());
+        assert!(err.contains("missing") && err.contains("not found"), "{err}");
+        std::fs::create_dir_all(dir.join("empty")).unwrap();
+        std::fs::write(dir.join("empty/notes.txt"), "no meshes here").unwrap();
+        let err = message(read_experts::<2>(&dir.join("empty"), None).unwrap_err());
+        assert!(err.contains("empty") && err.contains("no expert mesh"), "{err}");
+
+        // A geometry of another size than its mesh.
+        let polygon = r#"{"outer": [[0,0],[3,0],[3,1],[0,1]], "holes": []}"#;
+        std::fs::write(train.join("plate00.json"), polygon).unwrap();
+        let experts = read_experts::<2>(&train, None).unwrap();
+        assert_eq!(experts[0].geometry.as_deref(), Some(train.join("plate00.json").as_path()));
+        let err = message(problems::<2, PlanarPart>(experts, 0.2, &DatasetSettings::default()).unwrap_err());
+        assert!(err.contains("plate00.json") && err.contains("not the geometry of this mesh"), "{err}");
+        std::fs::remove_file(train.join("plate00.json")).unwrap();
+
+        // A mesh that does not parse.
+        std::fs::write(train.join("plate01.msh"), "$MeshFormat\ngarbage\n").unwrap();
+        let err = message(read_experts::<2>(&train, None).unwrap_err());
+        assert!(err.contains("plate01.msh"), "{err}");
+
+        // Mixed dimensions: a tet mesh among triangle meshes.
+        let tet =
+            Mesh::<3>::new(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3])
+                .unwrap();
+        amber_mesh::write_mesh(&tet, train.join("plate01.msh"), &amber_mesh::MeshData::default()).unwrap();
+        let err = message(read_experts::<2>(&train, None).unwrap_err());
+        assert!(err.contains("plate01.msh") && err.contains("mixed dimensions"), "{err}");
+
+        // An unreadable settings file.
+        std::fs::write(dir.join(SETTINGS_FILE), r#"{"initial_size": -1}"#).unwrap();
+        let err = message(DatasetSettings::read(&dir).unwrap_err());
+        assert!(err.contains(SETTINGS_FILE), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
