@@ -298,8 +298,7 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
 fn is_solid(geometry: &str) -> bool {
     let path = Path::new(geometry);
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    matches!(extension.as_deref(), Some("stl" | "obj"))
-        || (extension.as_deref() != Some("json") && read_mesh::<3>(path).is_ok())
+    matches!(extension.as_deref(), Some("stl" | "obj")) || matches!(read_any_mesh(path), Ok(AnyMesh::Three(..)))
 }
 
 fn mesh_with<F: SizingField<2>>(
