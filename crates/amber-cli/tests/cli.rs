@@ -274,3 +274,49 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success() && stderr.contains("val") && !stderr.contains("panicked"), "{stderr}");
 }
+
+/// Every model shipped in `models/` loads and meshes a geometry of its task from the geometry
+/// alone (a Poisson model with a load, no expert); reads `../shared/` for the Console surface.
+#[test]
+fn every_shipped_model_meshes_a_geometry_of_its_task() {
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let dir = tempfile::tempdir().unwrap();
+    let mut names: Vec<_> = std::fs::read_dir(&models).unwrap().map(|e| e.unwrap().file_name()).collect();
+    names.sort();
+    assert!(!names.is_empty(), "no shipped models in {}", models.display());
+    for name in names {
+        let name = name.to_str().unwrap();
+        let card: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(models.join(name).join("card.json")).unwrap()).unwrap();
+        let out = dir.path().join(format!("{name}.vtu"));
+        let mut command = amber();
+        command.args(["mesh", "--steps", "1", "--model", name, "-o"]).arg(&out).env("AMBER_MODELS", &models);
+        let volume = match card["task"].as_str() {
+            Some("poisson") => {
+                let problem = dir.path().join("load.json");
+                std::fs::write(
+                    &problem,
+                    r#"{"domain": {"polygon": [[0,0],[1,0],[1,0.5],[0.5,0.5],[0.5,1],[0,1]]},
+                        "load": {"means": [[0.3, 0.3]], "covariances": [[[0.001, 0], [0, 0.001]]], "weights": [1.0]}}"#,
+                )
+                .unwrap();
+                command.arg("--problem").arg(&problem);
+                0.75
+            }
+            Some("console") => {
+                let Some(data) = amber_testdata::shared("data/console") else { continue };
+                let stl = data.join("reference_surface/val/001.stl");
+                command.arg(&stl);
+                amber_meshgen::mesh3d::Surface::load(&stl, amber_mesh::StlFaceIds::FromFile).unwrap().0.enclosed_volume()
+            }
+            other => panic!("{name}: a card of an unknown task {other:?}"),
+        };
+        let output = command.output().unwrap();
+        assert!(output.status.success(), "{name}: {}", String::from_utf8_lossy(&output.stderr));
+        let total = match card["task"].as_str() {
+            Some("poisson") => amber_mesh::read_mesh::<2>(&out).unwrap().total_volume(),
+            _ => amber_mesh::read_mesh::<3>(&out).unwrap().total_volume(),
+        };
+        assert!((total / volume - 1.0).abs() < 5e-3, "{name}: volume {total} for {volume}");
+    }
+}
