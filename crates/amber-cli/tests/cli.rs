@@ -307,7 +307,10 @@ fn every_shipped_model_meshes_a_geometry_of_its_task() {
                 let Some(data) = amber_testdata::shared("data/console") else { continue };
                 let stl = data.join("reference_surface/val/001.stl");
                 command.arg(&stl);
-                amber_meshgen::mesh3d::Surface::load(&stl, amber_mesh::StlFaceIds::FromFile).unwrap().0.enclosed_volume()
+                amber_meshgen::mesh3d::Surface::load(&stl, amber_mesh::StlFaceIds::FromFile)
+                    .unwrap()
+                    .0
+                    .enclosed_volume()
             }
             other => panic!("{name}: a card of an unknown task {other:?}"),
         };
