@@ -2,9 +2,11 @@
 //!
 //! `amber mesh` meshes a geometry with a trained model (or a given sizing field) into a mesh file
 //! or picture; `amber train` trains AMBER (on generated Poisson problems or a folder of expert
-//! meshes); `amber evaluate` scores a model on a folder of expert meshes; `amber convert`
-//! converts between mesh file formats.
+//! meshes); `amber evaluate` scores a model on a folder of expert meshes; `amber calibrate` fits a
+//! model's element budget to a folder of expert meshes; `amber convert` converts between mesh file
+//! formats.
 
+mod calibrate;
 mod convert;
 mod evaluate;
 mod mesh;
@@ -30,6 +32,8 @@ enum Command {
     Convert(convert::ConvertArgs),
     /// Score a model on a folder of expert meshes: evaluation.json, evaluation.md, a picture per part.
     Evaluate(evaluate::EvaluateArgs),
+    /// Fit a model's element budget to a folder of expert meshes; write it as a new model directory.
+    Calibrate(calibrate::CalibrateArgs),
 }
 
 #[global_allocator]
@@ -46,5 +50,6 @@ fn main() -> anyhow::Result<()> {
         Command::Train(args) => train::train(args),
         Command::Convert(args) => convert::run(args),
         Command::Evaluate(args) => evaluate::run(args),
+        Command::Calibrate(args) => calibrate::run(args),
     }
 }

@@ -251,6 +251,48 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     let table = std::fs::read_to_string(out.join("evaluation.md")).unwrap();
     assert!(table.contains("| test/plate00 |") && table.contains("**mean**"), "{table}");
     println!("{table}");
+    let predictor: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("model/predictor.json")).unwrap()).unwrap();
+    let trained_scale = predictor["limits"]["final_step_scale"].as_f64().unwrap();
+    assert!(trained_scale != 1.0 && trained_scale > 0.0, "training fits the scale: {trained_scale}");
+
+    // Calibrated on the test plates, the model meshes them with their experts' counts (in the
+    // geometric mean over parts).
+    let calibrated = dir.path().join("calibrated");
+    let output = amber()
+        .args(["calibrate", "--model"])
+        .arg(&run)
+        .arg("--data")
+        .arg(data.join("test"))
+        .arg("-o")
+        .arg(&calibrated)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let out = dir.path().join("evaluation-calibrated");
+    let output = amber()
+        .args(["evaluate", "--model"])
+        .arg(&calibrated)
+        .arg("--data")
+        .arg(data.join("test"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let evaluation: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("evaluation.json")).unwrap()).unwrap();
+    let log_ratios: Vec<f64> = evaluation["parts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|part| {
+            let last = part["evaluation"]["steps"].as_array().unwrap().last().unwrap()["metrics"]["elements"].clone();
+            (last.as_f64().unwrap() / part["evaluation"]["expert_elements"].as_f64().unwrap()).ln()
+        })
+        .collect();
+    let ratio = (log_ratios.iter().sum::<f64>() / log_ratios.len() as f64).exp();
+    assert!((ratio - 1.0).abs() < 0.1, "calibrated counts / experts' {ratio}");
 
     let mesh = dir.path().join("plate.vtu");
     let plate = data.join("test/plate00.msh");

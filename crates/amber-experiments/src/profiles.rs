@@ -34,6 +34,8 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
         (Task::Console, _) => {
             // Spec §9: latent width 128, h_min at the 0.5 % quantile of the training experts' sizes.
             config.min_size_quantile = 0.005;
+
+            config.calibrate_element_count = true;
             if profile != Profile::Smoke {
                 config.network.latent_dim = 128;
             }
@@ -46,6 +48,7 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
         // Geometry is all a folder offers; log h(K) is the generic input every profile but the
         // paper's already reads.
         (Task::Folder { .. }, _) => {
+            config.calibrate_element_count = true;
             if !config.inputs.iter().any(|i| i == LOG_SIZE_COLUMN) {
                 config.inputs.push(LOG_SIZE_COLUMN.into());
             }

@@ -116,6 +116,15 @@ pub struct MeshLimits {
     /// budget, and meshes that.
     #[serde(default)]
     pub scale_to_budget: bool,
+    /// The last generation step's sizes are multiplied by this: fitted after training so that
+    /// the model's meshes of its training parts have their experts' element counts (1: not
+    /// fitted). See `amber_train::fit_final_step_scale`.
+    #[serde(default = "unit_scale")]
+    pub final_step_scale: f64,
+}
+
+fn unit_scale() -> f64 {
+    1.0
 }
 
 impl MeshLimits {
@@ -137,6 +146,7 @@ impl MeshLimits {
             min_size: quantile(&sizes, min_size_quantile),
             max_elements: (budget_factor * largest as f64) as usize,
             scale_to_budget: false,
+            final_step_scale: 1.0,
         }
     }
 

@@ -45,5 +45,5 @@ pub use error::{Result, TrainError};
 pub use method::{MethodConfig, TrainedModel};
 pub use rollout::{
     ElementTarget, Evaluation, EvaluationSummary, GeneratedStep, MeshMetrics, PredictedField, Reference, Rollout,
-    RolloutStep, SizingModel, StepStatus, StepSummary, generate, rollouts,
+    RolloutStep, SizingModel, StepStatus, StepSummary, fit_final_step_scale, generate, rollouts,
 };

@@ -8,7 +8,7 @@ use amber_tasks::{Domain, MeshLimits, Problem};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError};
-use crate::rollout::{ElementTarget, GeneratedStep, generate};
+use crate::rollout::{ElementTarget, GeneratedStep, fit_final_step_scale, generate};
 use crate::{
     AmberModel, CNN_PREDICTOR_FILE, CnnConfig, CnnModel, CnnObserver, CnnTraining, DataConfig, Evaluation, MODEL_DIR,
     Rollout, Training, TrainingConfig, TrainingObserver,
@@ -160,6 +160,31 @@ impl TrainedModel {
             TrainedModel::Amber(m) => generate(&m.sizing(), domain, steps, target),
             TrainedModel::Cnn(m) => generate(&m.sizing(), domain, steps, target),
         }
+    }
+
+    /// Fits the model's final step scale to the element counts of the experts of `problems`
+    /// after `steps` generation steps ([`fit_final_step_scale`]), replacing any earlier one;
+    /// returns it.
+    pub fn calibrate<const D: usize, P: Problem<D>>(&mut self, problems: &[P], steps: usize) -> Result<f64> {
+        self.limits_mut().final_step_scale = 1.0;
+        let scale = match self {
+            TrainedModel::Amber(m) => fit_final_step_scale(&m.sizing(), problems, steps)?,
+            TrainedModel::Cnn(m) => fit_final_step_scale(&m.sizing(), problems, steps)?,
+        };
+        self.limits_mut().final_step_scale = scale;
+        Ok(scale)
+    }
+
+    /// Writes everything but the weights (normalisers, limits) into the model directory `dir`,
+    /// which must hold this model's weights.
+    pub fn write_predictor(&self, dir: &Path) -> Result<()> {
+        let (file, json) = match self {
+            TrainedModel::Amber(m) => (crate::amber::PREDICTOR_FILE, serde_json::to_value(&m.predictor)),
+            TrainedModel::Cnn(m) => (CNN_PREDICTOR_FILE, serde_json::to_value(&m.predictor)),
+        };
+        let path = dir.join(file);
+        let json = json.map_err(|source| TrainError::Json { path: path.clone(), source })?;
+        Ok(amber_stdx::write_json_atomic(&path, &json)?)
     }
 
     /// h_min and the element budget.

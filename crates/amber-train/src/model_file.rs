@@ -31,6 +31,9 @@ pub(crate) fn check_limits(limits: &MeshLimits) -> Result<(), String> {
     if limits.max_elements == 0 {
         return Err("limits.max_elements is 0".into());
     }
+    if !(limits.final_step_scale.is_finite() && limits.final_step_scale > 0.0) {
+        return Err(format!("limits.final_step_scale is {}, not a positive factor", limits.final_step_scale));
+    }
     Ok(())
 }
 
@@ -59,7 +62,8 @@ mod tests {
         TargetTransform, WEIGHTS_FILE,
     };
 
-    const LIMITS: MeshLimits = MeshLimits { min_size: 0.01, max_elements: 1_000, scale_to_budget: false };
+    const LIMITS: MeshLimits =
+        MeshLimits { min_size: 0.01, max_elements: 1_000, scale_to_budget: false, final_step_scale: 1.0 };
 
     /// An untrained AMBER model (the console features: one node and two edge columns).
     fn amber_model(dir: &Path) {
@@ -144,6 +148,7 @@ mod tests {
         json("/limits/min_size", json!(0.0), "limits.min_size is 0");
         json("/limits/min_size", json!(-0.5), "limits.min_size is -0.5");
         json("/limits/max_elements", json!(0), "limits.max_elements is 0");
+        json("/limits/final_step_scale", json!(-2.0), "limits.final_step_scale is -2");
         let weights = |name: &'static str, needle: &str, edit: fn(&mut Vec<usize>, &mut Vec<f32>)| {
             assert_rejected(amber_model, load, WEIGHTS_FILE, needle, |f| edit_tensor(f, name, edit));
         };

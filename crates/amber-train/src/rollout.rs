@@ -113,6 +113,13 @@ pub struct PredictedField<const D: usize> {
     pub sizes: Vec<f64>,
 }
 
+impl<const D: usize> PredictedField<D> {
+    /// Multiplies every size by `factor`.
+    fn scale(&mut self, factor: f64) {
+        self.sizes.iter_mut().for_each(|h| *h *= factor);
+    }
+}
+
 /// What a trained method contributes to a generation step: a sizing field for the current mesh
 /// of each problem, and the clip and budget the step meshes it under. Both methods implement
 /// it; [`rollouts`] is the one loop around it.
@@ -132,6 +139,7 @@ pub trait SizingModel: Sync {
 /// for all running problems per step, then meshing and metrics in one parallel pass).
 /// `references[i]` belongs to `problems[i]`. A step over the budget or failed keeps the previous
 /// mesh and stops that problem's rollout; later steps carry it forward as [`StepStatus::Stopped`].
+/// The last step's field is scaled by the model's `final_step_scale`.
 pub fn rollouts<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
     model: &M,
     problems: &[P],
@@ -156,13 +164,16 @@ pub fn rollouts<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
         })
         .collect::<Result<_>>()?;
     let mut active = vec![true; problems.len()];
-    for _ in 0..steps {
+    for step in 1..=steps {
         let running: Vec<usize> = (0..problems.len()).filter(|&i| active[i]).collect();
         let current = |i: usize| out[i].steps.last().map_or(problems[i].initial_mesh(), |s| &s.mesh);
-        let fields = model.predict(
+        let mut fields = model.predict(
             &running.iter().map(|&i| &problems[i]).collect::<Vec<_>>(),
             &running.iter().map(|&i| current(i)).collect::<Vec<_>>(),
         )?;
+        if step == steps {
+            fields.iter_mut().for_each(|f| f.scale(model.limits().final_step_scale));
+        }
         let mut fields: Vec<Option<PredictedField<D>>> = fields.into_iter().map(Some).collect();
         let mut per_problem: Vec<Option<PredictedField<D>>> = (0..problems.len()).map(|_| None).collect();
         for (&i, field) in running.iter().zip(&mut fields) {
@@ -221,8 +232,9 @@ pub struct ElementTarget {
 /// Meshes `domain` with `model` for `steps` generation steps from its M⁰ (predict, clip at
 /// h_min, budget guard, mesh), as a rollout does but without an expert to compare with. With a
 /// `target`, the last step's field keeps its shape and is scaled to the target's element count
-/// (instead of the budget guard): the model decides where elements go, the user how many. A
-/// step that makes no mesh is an error naming the step.
+/// (instead of the budget guard): the model decides where elements go, the user how many;
+/// without one, by the model's `final_step_scale`. A step that makes no mesh is an error naming
+/// the step.
 pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     model: &M,
     domain: &P,
@@ -232,7 +244,10 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     let mut out: Vec<GeneratedStep<D>> = Vec::with_capacity(steps);
     for step in 1..=steps {
         let current = out.last().map_or(domain.initial_mesh(), |s| &s.mesh);
-        let field = model.predict(&[domain], &[current])?.pop().expect("one field per domain");
+        let mut field = model.predict(&[domain], &[current])?.pop().expect("one field per domain");
+        if step == steps && target.is_none() {
+            field.scale(model.limits().final_step_scale);
+        }
         let on = field.mesh.as_ref().unwrap_or(current);
         let mesh = match target.filter(|_| step == steps) {
             Some(target) => {
@@ -256,6 +271,63 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
         out.push(GeneratedStep { field, mesh });
     }
     Ok(out)
+}
+
+/// Meshings of the last step [`fit_final_step_scale`] spends per problem at most.
+const CALIBRATION_ROUNDS: usize = 3;
+
+/// A fitted scale within this factor of the previous round's is final.
+const CALIBRATION_TOLERANCE: f64 = 1.01;
+
+/// The factor on the last step's sizes that gives `model`'s meshes of `problems` after `steps`
+/// steps their experts' element counts, in the geometric mean over problems: the element budget
+/// the experts chose, learned from them. A model that learned where to refine but not how much
+/// overall (residual steps that converge short of the expert's level) is corrected by one
+/// number. `model` must have a `final_step_scale` of 1. The first `steps - 1` steps are
+/// generated once; the last is meshed with the current factor, which each round corrects by
+/// the mean ratio of counts to the power 1/D, until it moves by less than
+/// [`CALIBRATION_TOLERANCE`] or [`CALIBRATION_ROUNDS`] meshings are spent. A problem whose
+/// rollout or last meshing fails is left out of the mean.
+pub fn fit_final_step_scale<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
+    model: &M,
+    problems: &[P],
+    steps: usize,
+) -> Result<f64> {
+    if model.limits().final_step_scale != 1.0 {
+        return Err(TrainError::InvalidConfig("fitting a final step scale needs an unscaled model".into()));
+    }
+    let last_fields: Vec<(&P, Mesh<D>, PredictedField<D>)> = problems
+        .par_iter()
+        .filter_map(|p| {
+            let before = generate(model, p, steps.saturating_sub(1), None).ok()?;
+            let mesh = before.last().map_or(p.initial_mesh(), |s| &s.mesh).clone();
+            let field = model.predict(&[p], &[&mesh]).ok()?.pop()?;
+            Some((p, mesh, field))
+        })
+        .collect();
+    let limits = model.limits();
+    let mut scale = 1.0;
+    for _ in 0..CALIBRATION_ROUNDS {
+        let log_ratios: Vec<f64> = last_fields
+            .par_iter()
+            .filter_map(|(problem, mesh, field)| {
+                let sizes = field.sizes.iter().map(|h| (h * scale).max(limits.min_size)).collect();
+                let on = field.mesh.as_ref().unwrap_or(mesh);
+                let made = problem.remesh(on, sizes, limits.generator_cap()).ok()?;
+                Some((made.num_elements() as f64 / problem.expert_mesh().num_elements() as f64).ln())
+            })
+            .collect();
+        if log_ratios.is_empty() {
+            let reason = "no problem could be meshed to fit the final step scale".into();
+            return Err(TrainError::Generation { step: steps, reason });
+        }
+        let correction = (log_ratios.iter().sum::<f64>() / log_ratios.len() as f64 / D as f64).exp();
+        scale *= correction;
+        if correction.max(1.0 / correction) < CALIBRATION_TOLERANCE {
+            break;
+        }
+    }
+    Ok(scale)
 }
 
 /// Means over problems at one generation step.
@@ -344,5 +416,63 @@ impl<'p, const D: usize, P: Problem<D>> Evaluation<'p, D, P> {
         let rollouts = rollouts(model, self.problems, &self.references, steps)?;
         let summary = EvaluationSummary::new(self.problems, &rollouts);
         Ok((rollouts, summary))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use amber_meshgen::PolygonDomain;
+    use amber_tasks::WithExpert;
+    use amber_tasks::part::PlanarPart;
+
+    use super::*;
+
+    /// Asks for the same size everywhere, whatever the mesh.
+    struct Uniform {
+        size: f64,
+        limits: MeshLimits,
+    }
+
+    impl SizingModel for Uniform {
+        fn limits(&self) -> &MeshLimits {
+            &self.limits
+        }
+
+        fn predict<const D: usize, P: Domain<D>>(
+            &self,
+            _problems: &[&P],
+            meshes: &[&Mesh<D>],
+        ) -> Result<Vec<PredictedField<D>>> {
+            Ok(meshes.iter().map(|m| PredictedField { mesh: None, sizes: vec![self.size; m.num_elements()] }).collect())
+        }
+    }
+
+    /// A model that asks for twice the experts' size (a quarter of their elements) is scaled by
+    /// about one half, and its meshes then have the experts' counts; the last step alone is.
+    #[test]
+    fn the_final_step_scale_gives_the_experts_element_counts() {
+        let square = |side: f64| vec![[0.0, 0.0], [side, 0.0], [side, side], [0.0, side]];
+        let problems: Vec<WithExpert<PlanarPart, 2>> = [1.0, 1.5]
+            .into_iter()
+            .map(|side| {
+                let domain = PlanarPart::new("square".into(), PolygonDomain::new(square(side), vec![]).unwrap(), 0.2);
+                let domain = domain.unwrap();
+                let mesh = domain.initial_mesh().clone();
+                let expert_mesh = domain.remesh(&mesh, vec![0.04; mesh.num_elements()], 1_000_000).unwrap();
+                WithExpert { domain, expert_mesh }
+            })
+            .collect();
+        let limits =
+            MeshLimits { min_size: 1e-3, max_elements: 1_000_000, scale_to_budget: false, final_step_scale: 1.0 };
+        let mut model = Uniform { size: 0.08, limits };
+        let scale = fit_final_step_scale(&model, &problems, 2).unwrap();
+        assert!((0.45..0.55).contains(&scale), "scale {scale}");
+        let unscaled = generate(&model, &problems[1], 2, None).unwrap();
+        model.limits.final_step_scale = scale;
+        assert!(fit_final_step_scale(&model, &problems, 2).is_err(), "a scaled model is refitted from 1");
+        let scaled = generate(&model, &problems[1], 2, None).unwrap();
+        assert_eq!(scaled[0].mesh.num_elements(), unscaled[0].mesh.num_elements());
+        let (made, expert) = (scaled[1].mesh.num_elements() as f64, problems[1].expert_mesh.num_elements() as f64);
+        assert!((made / expert - 1.0).abs() < 0.05, "{made} elements for the expert's {expert}");
     }
 }

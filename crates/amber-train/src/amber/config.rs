@@ -110,6 +110,10 @@ pub struct TrainingConfig {
     pub min_size_quantile: f64,
     /// Generation steps T of a rollout (validation and inference).
     pub inference_steps: usize,
+    /// After training, fit the model's final step scale to the training experts' element counts
+    /// (`fit_final_step_scale`); off in the paper.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub calibrate_element_count: bool,
     /// Write a checkpoint every this many steps (and at the end).
     pub checkpoint_interval: u64,
     /// Roll out the validation problems every this many steps (and at the end); 0: never.
@@ -149,6 +153,7 @@ impl TrainingConfig {
             budget_factor: 1.2,
             min_size_quantile: 0.0,
             inference_steps: 5,
+            calibrate_element_count: false,
             checkpoint_interval: 2_560,
             validation_interval: 2_560,
         }

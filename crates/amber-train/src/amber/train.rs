@@ -24,7 +24,7 @@ use crate::checkpoint::{
 use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::{
     AmberModel, AmberSizing, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, TargetTransform,
-    TrainingConfig,
+    TrainingConfig, fit_final_step_scale,
 };
 
 /// The final model's sub-directory of the output directory.
@@ -356,6 +356,11 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
                 let dir = self.save_checkpoint(out_dir)?;
                 observer.checkpoint(step, &dir);
             }
+        }
+        if self.config.calibrate_element_count {
+            let sizing = AmberSizing { network: self.trainer.network(), predictor: &self.predictor };
+            let scale = fit_final_step_scale(&sizing, &self.problems, self.config.inference_steps)?;
+            self.predictor.limits.final_step_scale = scale;
         }
         self.save_model(&out_dir.join(MODEL_DIR))
     }

@@ -1,0 +1,90 @@
+//! `amber calibrate`: a trained model re-fitted to the element counts of a folder of expert
+//! meshes (its final step scale, see `amber_train::fit_final_step_scale`), written as a new
+//! model directory: where a team's experts mesh finer or coarser overall than the ones the model
+//! learned from, a handful of their meshes set the model's default element budget.
+
+use std::path::{Path, PathBuf};
+
+use amber_experiments::{ModelCard, Task, resolve_model};
+use amber_tasks::folder::{DatasetSettings, FolderDomain, Split, problems, read_experts};
+use amber_tasks::part::{PlanarPart, SolidPart};
+use amber_train::TrainedModel;
+use anyhow::{Context, bail};
+use clap::Args;
+
+use crate::mesh::shipped_models;
+
+#[derive(Args)]
+pub struct CalibrateArgs {
+    /// A trained model: a model or run directory, or a shipped model's name.
+    #[arg(long)]
+    model: String,
+    /// A directory of expert meshes, or a dataset folder whose `train/` is taken.
+    #[arg(long)]
+    data: PathBuf,
+    /// Generation steps the scale is fitted for (default: the model's own number).
+    #[arg(long)]
+    steps: Option<usize>,
+    /// The new model directory (the model's files with the fitted predictor).
+    #[arg(long, short)]
+    out: PathBuf,
+}
+
+pub fn run(args: CalibrateArgs) -> anyhow::Result<()> {
+    let dir = resolve_model(&args.model, &shipped_models())?;
+    let card = ModelCard::read(&dir)?;
+    let mut model = TrainedModel::load(&dir).with_context(|| format!("{}: cannot load the model", dir.display()))?;
+    let steps = args.steps.unwrap_or(card.inference_steps);
+    if steps == 0 {
+        bail!("--steps must be at least 1");
+    }
+    let train = Split::Train.dir(&args.data);
+    let split = if train.is_dir() { train } else { args.data.clone() };
+    let settings = DatasetSettings::read(split.parent().unwrap_or(Path::new(".")))?;
+    let before = model.limits().final_step_scale;
+    let scale = match card.task {
+        Task::Console | Task::Folder { dimension: 3 } => {
+            fit::<3, SolidPart>(&mut model, &split, &card, &settings, steps)?
+        }
+        Task::Folder { dimension: 2 } => fit::<2, PlanarPart>(&mut model, &split, &card, &settings, steps)?,
+        Task::Poisson => bail!("{}: a Poisson model is calibrated on Poisson problems, not meshes", dir.display()),
+        Task::Folder { dimension } => bail!("{}: a model of {dimension}D meshes", dir.display()),
+    };
+    copy_model(&dir, &args.out)?;
+    model.write_predictor(&args.out)?;
+    println!(
+        "final step scale {scale:.4} (was {before:.4}), fitted on {} after {steps} steps; wrote {}",
+        split.display(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Loads the experts of `split` as parts with the card's M⁰ and fits the model's scale on them.
+fn fit<const D: usize, P: FolderDomain<D>>(
+    model: &mut TrainedModel,
+    split: &Path,
+    card: &ModelCard,
+    settings: &DatasetSettings,
+    steps: usize,
+) -> anyhow::Result<f64> {
+    let parts = problems::<D, P>(read_experts::<D>(split, None)?, card.initial_size, settings)?;
+    Ok(model.calibrate(&parts, steps)?)
+}
+
+/// Copies the files of the model directory `from` (weights, predictor, card) into `to`.
+fn copy_model(from: &Path, to: &Path) -> anyhow::Result<()> {
+    if to.exists() && std::fs::read_dir(to).is_ok_and(|mut d| d.next().is_some()) {
+        bail!("{}: exists and is not empty; calibrate into a new directory", to.display());
+    }
+    std::fs::create_dir_all(to).with_context(|| format!("{}: cannot create", to.display()))?;
+    for entry in std::fs::read_dir(from).with_context(|| format!("{}: cannot read", from.display()))? {
+        let path = entry?.path();
+        if path.is_file() {
+            let target = to.join(path.file_name().expect("a file has a name"));
+            std::fs::copy(&path, &target)
+                .with_context(|| format!("{}: cannot copy to {}", path.display(), target.display()))?;
+        }
+    }
+    Ok(())
+}
