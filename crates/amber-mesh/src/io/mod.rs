@@ -150,7 +150,8 @@ pub fn read_mesh<const D: usize>(path: impl AsRef<Path>) -> Result<Mesh<D>, Mesh
 /// Reads a mesh with the fields and facet tags stored with it, and what was dropped.
 pub fn read_mesh_with_data<const D: usize>(path: impl AsRef<Path>) -> Result<(Mesh<D>, MeshData), MeshError> {
     let path = path.as_ref();
-    match read_raw(path)? {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
+    match parse_raw(path, bytes)? {
         Parsed::Json(bytes) => json::read(path, &bytes),
         Parsed::Raw(raw) => raw.finish(path),
     }
@@ -167,7 +168,14 @@ pub enum AnyMesh {
 /// elements decides (3: tetrahedra, 2: triangles). The file is parsed once.
 pub fn read_any_mesh(path: impl AsRef<Path>) -> Result<AnyMesh, MeshError> {
     let path = path.as_ref();
-    match read_raw(path)? {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
+    parse_any_mesh(path, bytes)
+}
+
+/// [`read_any_mesh`] of a file's contents: `path` chooses the format by its extension and names
+/// the file in errors (the fuzz targets and their replay test feed arbitrary bytes through it).
+pub fn parse_any_mesh(path: &Path, bytes: Vec<u8>) -> Result<AnyMesh, MeshError> {
+    match parse_raw(path, bytes)? {
         Parsed::Json(bytes) => match json::read::<3>(path, &bytes) {
             Err(MeshError::DimensionMismatch { found: 2, .. }) => {
                 json::read(path, &bytes).map(|(mesh, data)| AnyMesh::Two(mesh, data))
@@ -188,10 +196,9 @@ enum Parsed {
     Raw(raw::RawMesh),
 }
 
-fn read_raw(path: &Path) -> Result<Parsed, MeshError> {
+fn parse_raw(path: &Path, bytes: Vec<u8>) -> Result<Parsed, MeshError> {
     let format =
         format_of(path).ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: FORMATS })?;
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
     Ok(Parsed::Raw(match format {
         Format::Json => return Ok(Parsed::Json(bytes)),
         Format::Vtu => vtu::read(path, &bytes)?,
@@ -239,14 +246,36 @@ const SURFACE_FORMATS: &str = ".stl, .obj";
 /// ```
 pub fn read_surface(path: impl AsRef<Path>, stl_face_ids: StlFaceIds) -> Result<TriangleSoup, MeshError> {
     let path = path.as_ref();
-    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let is_stl = match extension.as_deref() {
-        Some("stl") => true,
-        Some("obj") => false,
-        _ => return Err(MeshError::UnsupportedFormat { path: path.to_owned(), expected: SURFACE_FORMATS }),
-    };
+    let format = SurfaceFormat::of(path)?;
     let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
-    if is_stl { stl::read(path, &bytes, stl_face_ids) } else { obj::read(path, &bytes) }
+    format.parse(path, &bytes, stl_face_ids)
+}
+
+/// [`read_surface`] of a file's contents: `path` chooses the format and names the file in errors.
+pub fn parse_surface(path: &Path, bytes: &[u8], stl_face_ids: StlFaceIds) -> Result<TriangleSoup, MeshError> {
+    SurfaceFormat::of(path)?.parse(path, bytes, stl_face_ids)
+}
+
+enum SurfaceFormat {
+    Stl,
+    Obj,
+}
+
+impl SurfaceFormat {
+    fn of(path: &Path) -> Result<Self, MeshError> {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("stl") => Ok(Self::Stl),
+            Some("obj") => Ok(Self::Obj),
+            _ => Err(MeshError::UnsupportedFormat { path: path.to_owned(), expected: SURFACE_FORMATS }),
+        }
+    }
+
+    fn parse(self, path: &Path, bytes: &[u8], stl_face_ids: StlFaceIds) -> Result<TriangleSoup, MeshError> {
+        match self {
+            Self::Stl => stl::read(path, bytes, stl_face_ids),
+            Self::Obj => obj::read(path, bytes),
+        }
+    }
 }
 
 /// Three whitespace-separated coordinates; the error says which word is wrong.

@@ -1,0 +1,98 @@
+//! The bodies of the fuzz targets: each takes arbitrary bytes, feeds them to one of amber's
+//! entry points for outside input (mesh files of every format, surface files, polygon domains
+//! and the meshers behind them), and panics only where amber broke a promise: a reader that
+//! panics, an error that does not name the file, a mesh that breaks the invariants its type
+//! guarantees, a mesher that exceeds its element cap. `fuzz/` wraps them for cargo-fuzz
+//! (libFuzzer, nightly); `tests/replay.rs` replays the committed corpus on stable in CI.
+
+use std::path::Path;
+
+use amber_mesh::{AnyMesh, Mesh, StlFaceIds, parse_any_mesh, parse_surface};
+use amber_meshgen::mesh3d::{Mesh3dParams, Surface, generate_3d};
+use amber_meshgen::{ConstantSize, Mesh2dParams, PolygonDomain, uniform_mesh_2d};
+
+/// A target's body: panics where amber broke a promise on `data`.
+pub type Target = fn(data: &[u8]);
+
+/// Every target by name, as `fuzz/fuzz_targets/<name>.rs` and `fuzz/corpus/<name>/` know it.
+pub const TARGETS: [(&str, Target); 3] =
+    [("mesh_file", mesh_file), ("surface_file", surface_file), ("polygon_domain", polygon_domain)];
+
+/// The extensions [`mesh_file`] chooses from with the input's first byte.
+const MESH_EXTENSIONS: [&str; 7] = ["msh", "vtu", "vtk", "nas", "inp", "mesh", "json"];
+
+/// Meshes made by the targets stay this small, so that an input runs in milliseconds.
+const ELEMENT_CAP: usize = 20_000;
+
+/// A mesh file: the first byte picks the format, the rest is the file. A mesh read is checked
+/// and its boundary made into a geometry (as a folder dataset without geometry files does).
+pub fn mesh_file(data: &[u8]) {
+    let Some((&format, contents)) = data.split_first() else { return };
+    let path = format!("fuzz.{}", MESH_EXTENSIONS[format as usize % MESH_EXTENSIONS.len()]);
+    match parse_any_mesh(Path::new(&path), contents.to_vec()) {
+        Ok(AnyMesh::Two(mesh, _)) => {
+            assert_valid(&mesh);
+            if let Ok(domain) = PolygonDomain::from_mesh_boundary(&mesh) {
+                assert!(domain.area() > 0.0 && domain.area().is_finite(), "area {}", domain.area());
+            }
+        }
+        Ok(AnyMesh::Three(mesh, _)) => {
+            assert_valid(&mesh);
+            if let Ok(mut surface) = Surface::from_mesh_boundary(&mesh) {
+                surface.split_faces_at_feature_edges(30.0);
+                let _ = surface.validate();
+            }
+        }
+        Err(e) => assert_names(&e.to_string(), &path),
+    }
+}
+
+/// A surface file (the first byte picks STL or OBJ): read, welded, validated as the boundary of
+/// a solid, and, when it is one, tetrahedralised at a uniform size under the element cap.
+pub fn surface_file(data: &[u8]) {
+    let Some((&format, contents)) = data.split_first() else { return };
+    let path = if format % 2 == 0 { "fuzz.stl" } else { "fuzz.obj" };
+    let soup = match parse_surface(Path::new(path), contents, StlFaceIds::FromFile) {
+        Ok(soup) => soup,
+        Err(e) => return assert_names(&e.to_string(), path),
+    };
+    assert_eq!(soup.corners.len(), 3 * soup.face_ids.len());
+    let Ok(mut surface) = Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0) else { return };
+    if surface.validate().is_err() || surface.triangles().len() > 2_000 {
+        return;
+    }
+    // About 30 tets' worth of the volume each: the size a part's M⁰ has.
+    let size = surface.enclosed_volume().cbrt() / 3.0;
+    let params = Mesh3dParams { max_elements: ELEMENT_CAP, ..Mesh3dParams::default() };
+    if let Ok(mesh) = generate_3d(&surface, &ConstantSize(size), &params) {
+        assert_valid(&mesh);
+        assert!(mesh.num_elements() <= ELEMENT_CAP, "{} tets over the cap", mesh.num_elements());
+    }
+}
+
+/// A polygon domain JSON (`{"outer": ..., "holes": ..., "size": h}`), meshed uniformly at `h`
+/// under the element cap: a size far too small for the domain must be refused, not attempted.
+pub fn polygon_domain(data: &[u8]) {
+    let Ok(mut value) = serde_json::from_slice::<serde_json::Value>(data) else { return };
+    let size = value.as_object_mut().and_then(|o| o.remove("size")).and_then(|s| s.as_f64()).unwrap_or(0.1);
+    let Ok(domain) = serde_json::from_value::<PolygonDomain>(value) else { return };
+    let params = Mesh2dParams::default().with_max_elements(ELEMENT_CAP);
+    if let Ok(mesh) = uniform_mesh_2d(&domain, size, &params) {
+        assert_valid(&mesh);
+        assert!(mesh.num_elements() <= ELEMENT_CAP, "{} triangles over the cap", mesh.num_elements());
+        let (area, covered) = (domain.area(), mesh.total_volume());
+        assert!((covered - area).abs() <= 1e-6 * area.abs().max(1e-300), "mesh area {covered} for domain {area}");
+    }
+}
+
+/// What `Mesh` promises: finite vertices, elements that index them, positive volumes.
+fn assert_valid<const D: usize>(mesh: &Mesh<D>) {
+    assert!(mesh.num_elements() > 0);
+    assert!(mesh.vertices().iter().flatten().all(|x| x.is_finite()));
+    assert!(mesh.volumes().iter().all(|&v| v > 0.0), "a non-positive element volume");
+}
+
+/// Errors about a file name it.
+fn assert_names(message: &str, path: &str) {
+    assert!(message.contains(path), "error without the file name: {message}");
+}
