@@ -1,14 +1,18 @@
 //! `cargo xtask reproduce poisson`: the paper's Poisson experiment end to end (datasets,
 //! training of every method × difficulty × seed, test rollouts, tables and plots under
-//! `results/poisson/`). Trained runs are cached under `data/runs/`, keyed by their config.
+//! `results/poisson/`); `reproduce console` and `ablate` likewise. Trained runs are cached under
+//! `data/runs/`, keyed by their config; `--plan`, `--only` and `--collect` hand the runs to a
+//! scheduler (`plan.rs`).
 
 use std::path::{Path, PathBuf};
 
-use amber_experiments::{ConsoleExperiment, ExperimentResults, Method, MethodSpec, PoissonExperiment};
+use amber_experiments::{ConsoleExperiment, ExperimentResults, Method, MethodSpec, PlannedRun, PoissonExperiment};
 use amber_stdx::read_json;
 use amber_tasks::console::TrainSet;
 use amber_tasks::poisson::Difficulty;
 use amber_train::Profile;
+
+use crate::plan::{self, Action, GridArgs};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -40,9 +44,8 @@ struct ConsoleArgs {
     methods: Vec<Method>,
     #[command(flatten)]
     overrides: OverrideArgs,
-    /// Retrain and re-evaluate even when cached.
-    #[arg(long)]
-    force: bool,
+    #[command(flatten)]
+    grid: GridArgs,
     /// Write under `results/` even from code with uncommitted changes (its results would name
     /// no commit that made them).
     #[arg(long)]
@@ -74,14 +77,15 @@ struct PoissonArgs {
     #[arg(long)]
     test_problems: Option<usize>,
     #[command(flatten)]
+    data: PoissonDataArgs,
+    #[command(flatten)]
     overrides: OverrideArgs,
     /// Skip a generation step whose field exceeds the element budget, as the paper does,
     /// instead of scaling the field to the budget (the default outside the paper profile).
     #[arg(long)]
     skip_over_budget: bool,
-    /// Retrain and re-evaluate even when cached.
-    #[arg(long)]
-    force: bool,
+    #[command(flatten)]
+    grid: GridArgs,
     /// Write under `results/` even from code with uncommitted changes (its results would name
     /// no commit that made them).
     #[arg(long)]
@@ -89,6 +93,15 @@ struct PoissonArgs {
     /// Output directory.
     #[arg(long, default_value = "results/poisson")]
     out: PathBuf,
+}
+
+/// Where the Poisson experiments keep their generated datasets.
+#[derive(clap::Args, Debug)]
+struct PoissonDataArgs {
+    /// Root of the generated Poisson datasets (`<root>/<difficulty>/<split>`), generated where
+    /// missing.
+    #[arg(long, value_name = "DIR", default_value = "data/poisson")]
+    data_root: PathBuf,
 }
 
 /// Config overrides from JSON files, shared by the experiments.
@@ -127,10 +140,10 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
         experiment.methods = args.methods.into_iter().map(MethodSpec::plain).collect();
     }
     (experiment.overrides, experiment.cnn_overrides) = args.overrides.read()?;
-    experiment.force = args.force;
+    experiment.cache = args.grid.cache_policy();
+    experiment.runs_root = args.grid.runs_root().into();
     experiment.out = args.out;
-    report(&experiment.run()?, &experiment.out);
-    Ok(())
+    schedule(&args.grid, &experiment.out, || experiment.plan(), |key| experiment.run_one(key), || experiment.run())
 }
 
 fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
@@ -153,10 +166,7 @@ fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
     if args.skip_over_budget {
         experiment.scale_to_budget = false;
     }
-    experiment.force = args.force;
-    experiment.out = args.out;
-    report(&experiment.run()?, &experiment.out);
-    Ok(())
+    poisson_schedule(experiment, args.data, &args.grid, args.out)
 }
 
 #[derive(clap::Args, Debug)]
@@ -164,9 +174,10 @@ pub struct AblateArgs {
     /// smoke (CI: minutes), quick (hours on 2 cores), paper (GPU scale).
     #[arg(long, default_value = "quick")]
     profile: Profile,
-    /// Retrain and re-evaluate even when cached.
-    #[arg(long)]
-    force: bool,
+    #[command(flatten)]
+    data: PoissonDataArgs,
+    #[command(flatten)]
+    grid: GridArgs,
     /// Write under `results/` even from code with uncommitted changes (its results would name
     /// no commit that made them).
     #[arg(long)]
@@ -179,11 +190,41 @@ pub struct AblateArgs {
 /// `cargo xtask ablate`: every ablation of spec §10 as variants of the same training code.
 pub fn ablate(args: AblateArgs) -> anyhow::Result<()> {
     check_provenance(&args.out, args.allow_dirty)?;
-    let mut experiment = PoissonExperiment::ablation(args.profile);
-    experiment.force = args.force;
-    experiment.out = args.out;
-    report(&experiment.run()?, &experiment.out);
-    Ok(())
+    poisson_schedule(PoissonExperiment::ablation(args.profile), args.data, &args.grid, args.out)
+}
+
+/// Runs the Poisson `experiment` (or its ablations) on the datasets of `data` as `grid` says,
+/// writing results to `out`.
+fn poisson_schedule(
+    mut experiment: PoissonExperiment,
+    data: PoissonDataArgs,
+    grid: &GridArgs,
+    out: PathBuf,
+) -> anyhow::Result<()> {
+    experiment.data_root = data.data_root;
+    experiment.cache = grid.cache_policy();
+    experiment.runs_root = grid.runs_root().into();
+    experiment.out = out;
+    schedule(grid, &experiment.out, || experiment.plan(), |key| experiment.run_one(key), || experiment.run())
+}
+
+/// Does what `grid` asks of an experiment given as its three entry points: writes the plan of
+/// its runs, runs one of them, or runs (or collects) them all and reports the results in `out`.
+fn schedule(
+    grid: &GridArgs,
+    out: &Path,
+    plan: impl FnOnce() -> anyhow::Result<Vec<PlannedRun>>,
+    run_one: impl FnOnce(&str) -> anyhow::Result<()>,
+    run: impl FnOnce() -> anyhow::Result<ExperimentResults>,
+) -> anyhow::Result<()> {
+    match grid.action() {
+        Action::Plan(file) => plan::write(file, &plan()?),
+        Action::Only(key) => run_one(key),
+        Action::All => {
+            report(&run()?, out);
+            Ok(())
+        }
+    }
 }
 
 /// Refuses to write under `results/` (the committed evidence) from a binary built from a dirty

@@ -1,7 +1,8 @@
 //! The Console experiment (spec §9, §10): AMBER-Mean, AMBER-Max and the 3D CNNs trained on the
 //! real car-seat parts, evaluated on `test/` when the data has it, else on `val/`; the same
 //! outputs as the Poisson experiment, with galleries of the meshes' surfaces from two
-//! viewpoints and the final meshes as `.vtu` for ParaView.
+//! viewpoints and the final meshes as `.vtu` for ParaView. Its runs can be planned and run one
+//! by one as the Poisson experiment's can.
 
 use std::path::{Path, PathBuf};
 
@@ -15,11 +16,12 @@ use amber_train::{MethodConfig, Profile};
 use anyhow::bail;
 use serde::Serialize;
 
+use crate::grid::{CachePolicy, GridRun, PlannedRun, unknown_run};
 use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::profiles::{Overrides, Task, run_config};
 use crate::results::ExperimentResults;
-use crate::run::{GALLERY_PROBLEMS, Run, evaluation_name, train_run};
+use crate::run::{CachedEvaluation, GALLERY_PROBLEMS, Run, evaluation_name, train_run};
 
 /// The two viewpoints of the galleries.
 const VIEWS: [View; 2] =
@@ -48,8 +50,8 @@ pub struct ConsoleExperiment {
     /// budget and mesh it (spec §11, the later version) instead of skipping the step (the
     /// paper). Training is not affected.
     pub scale_to_budget: bool,
-    /// Retrain and re-evaluate even when cached.
-    pub force: bool,
+    /// Whether cached runs are reused, retrained or required.
+    pub cache: CachePolicy,
 }
 
 impl ConsoleExperiment {
@@ -71,7 +73,7 @@ impl ConsoleExperiment {
             overrides: serde_json::json!({}),
             cnn_overrides: serde_json::json!({}),
             scale_to_budget: profile != Profile::Paper,
-            force: false,
+            cache: CachePolicy::Reuse,
         }
     }
 
@@ -81,8 +83,57 @@ impl ConsoleExperiment {
         run_config(Task::Console, self.profile, spec, seed, overrides)
     }
 
-    /// Runs the experiment and writes its outputs under `out`.
+    /// Runs the experiment and writes its outputs under `out`: trains and evaluates every run
+    /// as [`Self::cache`] says, then writes `results.json`, `table.md` and the pictures from the
+    /// runs' evaluations.
     pub fn run(&self) -> anyhow::Result<ExperimentResults> {
+        let grid = self.grid()?;
+        self.cache.prepare(&grid.runs)?;
+        let mut runs = Vec::new();
+        let mut configs = Vec::new();
+        let mut rows: Vec<(String, Vec<Vec<Mesh3>>)> = Vec::new();
+        for r in &grid.runs {
+            let evaluated = self.train_and_evaluate(&grid, r)?;
+            configs.push(serde_json::json!({
+                "method": r.spec.method, "variant": r.spec.variant.name, "seed": r.seed, "run_dir": r.run.dir,
+                "training": r.config,
+            }));
+            runs.push(evaluated.result(&r.spec, "console", r.seed));
+            if r.seed == 0 && r.spec.variant.name == "default" {
+                rows.push((r.spec.label(), r.run.gallery_meshes(r.config.inference_steps())?));
+            }
+        }
+        let test_split = grid.test_split.name();
+        let config = serde_json::json!({ "experiment": self, "test_split": test_split, "runs": configs });
+        let results = ExperimentResults::new("console", self.profile.name(), config, runs);
+        let setting = Setting { name: "console".into(), caption: format!("Console ({test_split} parts)") };
+        write_outputs(&self.out, &results, &[setting], &self.methods, &paper_number)?;
+        let experts: Vec<&Mesh3> = grid.test.iter().take(GALLERY_PROBLEMS).map(|p| &p.expert_mesh).collect();
+        for (k, view) in VIEWS.into_iter().enumerate() {
+            let tiles = gallery_rows(&rows, &experts, solid_tile(view), Mesh3::num_elements);
+            mesh_gallery(&self.out.join(format!("gallery_console_view{}.png", k + 1)), &tiles, (460, 380))?;
+        }
+        Ok(results)
+    }
+
+    /// Every run, in table order, for a scheduler to run apart with [`Self::run_one`] (the data
+    /// folder is only read).
+    pub fn plan(&self) -> anyhow::Result<Vec<PlannedRun>> {
+        Ok(self.grid()?.runs.iter().map(GridRun::planned).collect())
+    }
+
+    /// Trains and evaluates the run with `key` (a [`PlannedRun::key`]) alone, as
+    /// [`Self::cache`] says; writes nothing outside its directory.
+    pub fn run_one(&self, key: &str) -> anyhow::Result<()> {
+        let grid = self.grid()?;
+        let r = grid.runs.iter().find(|r| r.has_key(key)).ok_or_else(|| unknown_run(key, &grid.runs))?;
+        self.cache.prepare([r])?;
+        self.train_and_evaluate(&grid, r)?;
+        Ok(())
+    }
+
+    /// The test parts and the runs (seed-major, then the methods' order).
+    fn grid(&self) -> anyhow::Result<ConsoleGrid> {
         if self.methods.is_empty() || self.seeds == 0 {
             bail!("nothing to run: give at least one method and seed");
         }
@@ -91,47 +142,30 @@ impl ConsoleExperiment {
         let test = self.load(test_split, usize::MAX)?;
         let test_name =
             evaluation_name(format!("console {} ({} parts)", test_split.name(), test.len()), self.scale_to_budget);
+        let data = serde_json::json!({
+            "dir": self.data, "train_set": self.train_set, "initial_mesh": INITIAL_MESH_RECIPE,
+        });
         let mut runs = Vec::new();
-        let mut configs = Vec::new();
-        let mut rows: Vec<(String, Vec<Vec<Mesh3>>)> = Vec::new();
         for seed in 0..self.seeds {
             for spec in &self.methods {
                 let config = self.run_config(spec, seed)?;
-                let data = serde_json::json!({
-                    "dir": self.data, "train_set": self.train_set, "initial_mesh": INITIAL_MESH_RECIPE,
-                });
-                let run = Run::new(&self.runs_root, "console", "console", spec, &config, data, &test_name);
-                if self.force {
-                    run.clear()?;
-                }
-                let evaluated = run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| {
-                    let problems = |validates: bool| {
-                        let val =
-                            if validates { self.load(Split::Val, config.data().val_problems)? } else { Vec::new() };
-                        Ok((self.load(Split::Train, config.data().train_problems)?, val))
-                    };
-                    train_run(&config, problems, dir, label)
-                })?;
-                configs.push(serde_json::json!({
-                    "method": spec.method, "variant": spec.variant.name, "seed": seed, "run_dir": run.dir,
-                    "training": config,
-                }));
-                runs.push(evaluated.result(spec, "console", seed));
-                if seed == 0 && spec.variant.name == "default" {
-                    rows.push((spec.label(), run.gallery_meshes(config.inference_steps())?));
-                }
+                let run = Run::new(&self.runs_root, "console", "console", spec, &config, data.clone(), &test_name);
+                runs.push(GridRun { spec: spec.clone(), seed, config, run });
             }
         }
-        let config = serde_json::json!({ "experiment": self, "test_split": test_split.name(), "runs": configs });
-        let results = ExperimentResults::new("console", self.profile.name(), config, runs);
-        let setting = Setting { name: "console".into(), caption: format!("Console ({} parts)", test_split.name()) };
-        write_outputs(&self.out, &results, &[setting], &self.methods, &paper_number)?;
-        let experts: Vec<&Mesh3> = test.iter().take(GALLERY_PROBLEMS).map(|p| &p.expert_mesh).collect();
-        for (k, view) in VIEWS.into_iter().enumerate() {
-            let tiles = gallery_rows(&rows, &experts, solid_tile(view), Mesh3::num_elements);
-            mesh_gallery(&self.out.join(format!("gallery_console_view{}.png", k + 1)), &tiles, (460, 380))?;
-        }
-        Ok(results)
+        Ok(ConsoleGrid { test_split, test, runs })
+    }
+
+    /// Trains (or reuses) and evaluates one run of the grid.
+    fn train_and_evaluate(&self, grid: &ConsoleGrid, r: &GridRun) -> anyhow::Result<CachedEvaluation> {
+        let data = r.config.data();
+        r.run.train_and_evaluate(&r.config, &grid.test, self.scale_to_budget, |dir, label| {
+            let problems = |validates: bool| {
+                let val = if validates { self.load(Split::Val, data.val_problems)? } else { Vec::new() };
+                Ok((self.load(Split::Train, data.train_problems)?, val))
+            };
+            train_run(&r.config, problems, dir, label)
+        })
     }
 
     /// The first `count` parts of a split (all of them for `usize::MAX`; of the training split,
@@ -145,6 +179,13 @@ impl ConsoleExperiment {
         let experts = read_experts::<3>(&split.dir(&self.data), Some(limit))?;
         Ok(problems(experts, INITIAL_SIZE, &DatasetSettings::read(&self.data)?)?)
     }
+}
+
+/// The grid of the Console experiment: its test parts and its runs.
+struct ConsoleGrid {
+    test_split: Split,
+    test: Vec<WithExpert<SolidPart, 3>>,
+    runs: Vec<GridRun>,
 }
 
 /// A gallery tile of a mesh's surface from `view`, coloured by element size.

@@ -4,11 +4,14 @@
 //! configuration (trained models are reused, killed runs resume), evaluation on the test
 //! problems with the paper's metrics, and the outputs every experiment writes: `results.json`
 //! in one schema ([`ExperimentResults`]), `table.md` with the paper's numbers beside ours, and
-//! PNG charts and mesh galleries. Progress goes to the terminal as bars and lines.
+//! PNG charts and mesh galleries. An experiment's runs can also be listed ([`PlannedRun`]), run
+//! one at a time by a scheduler, and collected from their caches ([`CachePolicy::Require`]).
+//! Progress goes to the terminal as bars and lines.
 
 mod card;
 mod console;
 mod folder;
+mod grid;
 mod method;
 mod outputs;
 mod poisson;
@@ -22,6 +25,7 @@ mod table;
 pub use card::{CARD_FILE, CardEvaluation, ModelCard, resolve_model};
 pub use console::ConsoleExperiment;
 pub use folder::{FolderTraining, train_folder};
+pub use grid::{CachePolicy, PlannedRun};
 pub use method::{Method, MethodSpec, Variant};
 pub use poisson::{PoissonExperiment, train_poisson};
 pub use profiles::{Task, amber_config, cnn_config};

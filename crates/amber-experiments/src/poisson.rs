@@ -1,6 +1,7 @@
 //! The Poisson experiment (spec §1, §6, §7, §10): datasets → training of every method ×
 //! difficulty × seed (cached runs, resumable) → rollouts on the test problems → `results.json`,
-//! `table.md`, bar and per-step charts and a mesh gallery.
+//! `table.md`, bar and per-step charts and a mesh gallery; or the same runs planned for a
+//! scheduler, the datasets generated once beforehand, and run one by one.
 
 use std::path::{Path, PathBuf};
 
@@ -14,13 +15,14 @@ use amber_train::{MethodConfig, Profile};
 use anyhow::bail;
 use serde::Serialize;
 
+use crate::grid::{CachePolicy, GridRun, PlannedRun, unknown_run};
 use crate::method::{Method, MethodSpec, Variant};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::profiles::{Overrides, Task, amber_config, run_config};
 use crate::progress::item_bar;
 use crate::report::merge_json;
 use crate::results::ExperimentResults;
-use crate::run::{GALLERY_PROBLEMS, Run, evaluation_name, train_run};
+use crate::run::{CachedEvaluation, GALLERY_PROBLEMS, Run, evaluation_name, train_run};
 
 /// Everything an invocation of the Poisson experiment decides.
 #[derive(Clone, Debug, Serialize)]
@@ -52,8 +54,8 @@ pub struct PoissonExperiment {
     /// budget and mesh it (spec §11, the later version) instead of skipping the step (the
     /// paper). Training is not affected.
     pub scale_to_budget: bool,
-    /// Retrain and re-evaluate even when cached.
-    pub force: bool,
+    /// Whether cached runs are reused, retrained or required.
+    pub cache: CachePolicy,
 }
 
 impl PoissonExperiment {
@@ -80,7 +82,7 @@ impl PoissonExperiment {
             overrides: serde_json::json!({}),
             cnn_overrides: serde_json::json!({}),
             scale_to_budget: profile != Profile::Paper,
-            force: false,
+            cache: CachePolicy::Reuse,
         }
     }
 
@@ -159,41 +161,29 @@ impl PoissonExperiment {
         run_config(Task::Poisson, self.profile, spec, seed, overrides)
     }
 
-    /// Runs the experiment and writes its outputs under `out`.
+    /// Runs the experiment and writes its outputs under `out`: trains and evaluates every run
+    /// of the grid as [`Self::cache`] says, then writes `results.json`, `table.md` and the
+    /// pictures from the runs' evaluations.
     pub fn run(&self) -> anyhow::Result<ExperimentResults> {
-        if self.methods.is_empty() || self.difficulties.is_empty() || self.seeds == 0 {
-            bail!("nothing to run: give at least one method, difficulty and seed");
-        }
-        let manifest: serde_json::Value = read_json(&self.manifest)?;
+        let grid = self.grid()?;
+        self.cache.prepare(grid.iter().flat_map(|d| &d.runs))?;
         let mut runs = Vec::new();
         let mut configs = Vec::new();
         let mut galleries = Vec::new();
-        for &difficulty in &self.difficulties {
-            let (test, test_name) = self.test_problems(difficulty)?;
-            let test_name = evaluation_name(test_name, self.scale_to_budget);
+        for d in &grid {
             let mut rows: Vec<(String, Vec<Vec<Mesh2>>)> = Vec::new();
-            for seed in 0..self.seeds {
-                for spec in &self.methods {
-                    let config = self.run_config(spec, seed)?;
-                    let data = serde_json::json!({ "manifest": manifest, "difficulty": difficulty });
-                    let run = Run::new(&self.runs_root, "poisson", difficulty.name(), spec, &config, data, &test_name);
-                    if self.force {
-                        run.clear()?;
-                    }
-                    let evaluated = run.train_and_evaluate(&config, &test, self.scale_to_budget, |dir, label| {
-                        train_poisson(&config, difficulty, &self.data_root, &self.manifest, dir, label)
-                    })?;
-                    configs.push(serde_json::json!({
-                        "method": spec.method, "variant": spec.variant.name, "difficulty": difficulty.name(),
-                        "seed": seed, "run_dir": run.dir, "training": config,
-                    }));
-                    runs.push(evaluated.result(spec, difficulty.name(), seed));
-                    if seed == 0 && spec.variant.name == "default" {
-                        rows.push((spec.label(), run.gallery_meshes(config.inference_steps())?));
-                    }
+            for r in &d.runs {
+                let evaluated = self.train_and_evaluate(d, r)?;
+                configs.push(serde_json::json!({
+                    "method": r.spec.method, "variant": r.spec.variant.name, "difficulty": d.difficulty.name(),
+                    "seed": r.seed, "run_dir": r.run.dir, "training": r.config,
+                }));
+                runs.push(evaluated.result(&r.spec, d.difficulty.name(), r.seed));
+                if r.seed == 0 && r.spec.variant.name == "default" {
+                    rows.push((r.spec.label(), r.run.gallery_meshes(r.config.inference_steps())?));
                 }
             }
-            galleries.push((difficulty, test, rows));
+            galleries.push((d.difficulty, &d.test, rows));
         }
         let config = serde_json::json!({ "experiment": self, "runs": configs });
         let results = ExperimentResults::new(&self.experiment, self.profile.name(), config, runs);
@@ -212,6 +202,75 @@ impl PoissonExperiment {
             mesh_gallery(&self.out.join(format!("gallery_{difficulty}.png")), &tiles, (420, 380))?;
         }
         Ok(results)
+    }
+
+    /// Every run of the grid, in table order, for a scheduler to run apart with
+    /// [`Self::run_one`]. Generates every dataset split the runs read first, so that the runs
+    /// find their data cached and only write their own directories.
+    pub fn plan(&self) -> anyhow::Result<Vec<PlannedRun>> {
+        let grid = self.grid()?;
+        for d in &grid {
+            for r in &d.runs {
+                self.training_problems(&r.config, d.difficulty)(r.config.validates())?;
+            }
+        }
+        Ok(grid.iter().flat_map(|d| d.runs.iter().map(GridRun::planned)).collect())
+    }
+
+    /// Trains and evaluates the run with `key` (a [`PlannedRun::key`]) alone, as
+    /// [`Self::cache`] says; writes nothing outside its directory.
+    pub fn run_one(&self, key: &str) -> anyhow::Result<()> {
+        let grid = self.grid()?;
+        let found = grid.iter().flat_map(|d| d.runs.iter().map(move |r| (d, r))).find(|(_, r)| r.has_key(key));
+        let (d, r) = found.ok_or_else(|| unknown_run(key, grid.iter().flat_map(|d| &d.runs)))?;
+        self.cache.prepare([r])?;
+        self.train_and_evaluate(d, r)?;
+        Ok(())
+    }
+
+    /// Per difficulty, its test problems and runs (seed-major, then the methods' order).
+    fn grid(&self) -> anyhow::Result<Vec<DifficultyRuns>> {
+        if self.methods.is_empty() || self.difficulties.is_empty() || self.seeds == 0 {
+            bail!("nothing to run: give at least one method, difficulty and seed");
+        }
+        let manifest: serde_json::Value = read_json(&self.manifest)?;
+        let mut grid = Vec::new();
+        for &difficulty in &self.difficulties {
+            let (test, test_name) = self.test_problems(difficulty)?;
+            let test_name = evaluation_name(test_name, self.scale_to_budget);
+            let data = serde_json::json!({ "manifest": manifest, "difficulty": difficulty });
+            let mut runs = Vec::new();
+            for seed in 0..self.seeds {
+                for spec in &self.methods {
+                    let config = self.run_config(spec, seed)?;
+                    let run = Run::new(
+                        &self.runs_root,
+                        "poisson",
+                        difficulty.name(),
+                        spec,
+                        &config,
+                        data.clone(),
+                        &test_name,
+                    );
+                    runs.push(GridRun { spec: spec.clone(), seed, config, run });
+                }
+            }
+            grid.push(DifficultyRuns { difficulty, test, runs });
+        }
+        Ok(grid)
+    }
+
+    /// Trains (or reuses) and evaluates one run of the grid.
+    fn train_and_evaluate(&self, d: &DifficultyRuns, r: &GridRun) -> anyhow::Result<CachedEvaluation> {
+        r.run.train_and_evaluate(&r.config, &d.test, self.scale_to_budget, |dir, label| {
+            train_run(&r.config, self.training_problems(&r.config, d.difficulty), dir, label)
+        })
+    }
+
+    /// The training problems of a run of `config` and, when asked, its validation problems,
+    /// generated under `data_root` first where missing.
+    fn training_problems(&self, config: &MethodConfig, difficulty: Difficulty) -> impl FnOnce(bool) -> Problems {
+        poisson_problems(config, difficulty, &self.data_root, &self.manifest)
     }
 
     /// The first `count` problems of a split, generated first where missing.
@@ -243,6 +302,13 @@ impl PoissonExperiment {
         let name = format!("{name} ({} problems)", problems.len());
         Ok((problems, name))
     }
+}
+
+/// One difficulty of the grid: its test problems and its runs.
+struct DifficultyRuns {
+    difficulty: Difficulty,
+    test: Vec<PoissonProblem>,
+    runs: Vec<GridRun>,
 }
 
 /// The paper's normalised DCD (spec §10) of a row on Poisson hard, the only difficulty whose
@@ -282,8 +348,22 @@ pub fn train_poisson(
     dir: &Path,
     label: &str,
 ) -> anyhow::Result<f64> {
-    let (seed, data) = (config.seed() as usize, config.data());
-    let problems = |validates: bool| {
+    train_run(config, poisson_problems(config, difficulty, data_root, manifest), dir, label)
+}
+
+/// A run's training problems and, when it validates, its validation problems.
+type Problems = anyhow::Result<(Vec<PoissonProblem>, Vec<PoissonProblem>)>;
+
+/// The training problems of a run of `config` and, when asked, the validation problems (see
+/// [`train_run`]), generated under `data_root` first where missing.
+fn poisson_problems<'a>(
+    config: &MethodConfig,
+    difficulty: Difficulty,
+    data_root: &'a Path,
+    manifest: &'a Path,
+) -> impl FnOnce(bool) -> Problems + 'a {
+    let (seed, data) = (config.seed() as usize, config.data().clone());
+    move |validates: bool| {
         let train = load_problems(data_root, manifest, difficulty, Split::Train, seed, data.train_problems)?;
         let val = if validates {
             load_problems(data_root, manifest, difficulty, Split::Val, 0, data.val_problems)?
@@ -291,8 +371,7 @@ pub fn train_poisson(
             Vec::new()
         };
         Ok((train, val))
-    };
-    train_run(config, problems, dir, label)
+    }
 }
 
 /// The first `count` problems of a split, generated first where missing (with a progress bar).

@@ -60,6 +60,8 @@ impl CachedEvaluation {
 /// A run directory: `<runs>/<task>/<setting>/<method>[-<variant>]/seed<r>-<hash>`, where the
 /// hash covers the config and `data` (what identifies the training data).
 pub(crate) struct Run {
+    /// The directory's path under the runs root: the run's name in a plan.
+    pub key: String,
     pub dir: PathBuf,
     pub label: String,
     test_name: String,
@@ -80,13 +82,22 @@ impl Run {
             "default" => spec.method.name(),
             variant => format!("{}-{variant}", spec.method.name()),
         };
-        let key = serde_json::json!({ "config": config.to_json(), "data": data });
-        let dir =
-            runs_root.join(task).join(setting).join(&name).join(format!("seed{}-{}", config.seed(), config_hash(&key)));
+        let hashed = serde_json::json!({ "config": config.to_json(), "data": data });
+        let key = format!("{task}/{setting}/{name}/seed{}-{}", config.seed(), config_hash(&hashed));
+        let dir = runs_root.join(&key);
         // Evaluations are keyed by the test set and how it is evaluated.
         let eval_dir = dir.join(format!("eval-{}", config_hash(&serde_json::json!(test_name))));
         let label = format!("{} {setting} seed {}", spec.label(), config.seed());
-        Self { dir, label, test_name: test_name.into(), eval_dir }
+        Self { key, dir, label, test_name: test_name.into(), eval_dir }
+    }
+
+    fn evaluation_path(&self) -> PathBuf {
+        self.eval_dir.join("evaluation.json")
+    }
+
+    /// Whether the run's evaluation on its test set is cached (the run is done).
+    pub fn is_evaluated(&self) -> bool {
+        self.evaluation_path().exists()
     }
 
     /// Deletes what the run directory holds, so that the run is trained and evaluated afresh.
@@ -109,7 +120,7 @@ impl Run {
         scale_to_budget: bool,
         train: impl FnOnce(&Path, &str) -> anyhow::Result<f64>,
     ) -> anyhow::Result<CachedEvaluation> {
-        let cache = self.eval_dir.join("evaluation.json");
+        let cache = self.evaluation_path();
         if cache.exists() {
             let cached: CachedEvaluation = read_json(&cache)?;
             println!("{}: reusing the evaluation in {}", self.label, cache.display());

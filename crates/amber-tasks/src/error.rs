@@ -43,3 +43,12 @@ pub enum TaskError {
     #[error("problem with seed {seed}: {source}")]
     Fem { seed: u64, source: FemError },
 }
+
+impl From<amber_stdx::FileError> for TaskError {
+    fn from(e: amber_stdx::FileError) -> Self {
+        match e {
+            amber_stdx::FileError::Io { path, source } => TaskError::Io { path, source },
+            amber_stdx::FileError::Json { path, source } => TaskError::Json { path, source },
+        }
+    }
+}

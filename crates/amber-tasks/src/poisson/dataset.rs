@@ -165,6 +165,12 @@ type Outcome = Result<(CacheEntry, bool), TaskError>;
 /// every file whose inputs and content hash match `dir/index.json`. `on_problem` is called once
 /// per problem, when it is done or found cached (for progress bars).
 ///
+/// Safe to run concurrently on one split (the runs of a plan may): every file appears
+/// atomically, a problem generates the same bytes in any process, the index keeps the entries
+/// of problems beyond `request.count`, and a split found whole in the cache is not written at
+/// all. Two processes that both miss a file generate it twice, and an index entry lost to a
+/// concurrent rewrite only costs a regeneration later.
+///
 /// The first failing problem's error is returned after the others finished and the index was
 /// written, so a rerun only redoes what failed.
 pub fn write_split(
@@ -198,7 +204,7 @@ pub fn write_split(
                 _ => PoissonProblem::generate(seed, steps, request.initial_size, &request.heuristic).and_then(
                     |problem| {
                         let json = problem.to_json();
-                        std::fs::write(&path, &json).map_err(|source| TaskError::Io { path: path.clone(), source })?;
+                        amber_stdx::write_atomic(&path, &json)?;
                         Ok((CacheEntry { inputs, content: hex(&Sha256::digest(&json)) }, false))
                     },
                 ),
@@ -208,7 +214,7 @@ pub fn write_split(
         })
         .collect();
 
-    let mut index = BTreeMap::new();
+    let mut index = old_index.clone();
     let mut report = SplitReport::default();
     let mut first_error = None;
     for (name, outcome) in outcomes {
@@ -226,8 +232,9 @@ pub fn write_split(
             }
         }
     }
-    let json = serde_json::to_vec_pretty(&index).expect("string maps always serialise");
-    std::fs::write(&index_path, json).map_err(|source| TaskError::Io { path: index_path, source })?;
+    if index != old_index {
+        amber_stdx::write_json_atomic(&index_path, &index)?;
+    }
     match first_error {
         Some(e) => Err(e),
         None => Ok(report),
@@ -330,12 +337,20 @@ mod tests {
         };
         assert_eq!(write_split(&request, &dir, &tick).unwrap(), SplitReport { written: 2, cached: 0 });
         let first = std::fs::read(dir.join("001.json")).unwrap();
+        // A split found whole in the cache is not written (its index keeps its inode), nor is a
+        // shorter prefix of it: the concurrent runs of a plan only read their data.
+        use std::os::unix::fs::MetadataExt;
+        let inode = || std::fs::metadata(dir.join(INDEX_FILE)).unwrap().ino();
+        let before = inode();
         assert_eq!(write_split(&request, &dir, &tick).unwrap(), SplitReport { written: 0, cached: 2 });
+        let prefix = SplitRequest { count: 1, ..request.clone() };
+        assert_eq!(write_split(&prefix, &dir, &tick).unwrap(), SplitReport { written: 0, cached: 1 });
+        assert_eq!(inode(), before);
         // A tampered file is regenerated, byte-identical to the first run.
         std::fs::write(dir.join("001.json"), b"{}").unwrap();
         assert_eq!(write_split(&request, &dir, &tick).unwrap(), SplitReport { written: 1, cached: 1 });
         assert_eq!(std::fs::read(dir.join("001.json")).unwrap(), first);
-        assert_eq!(done.load(std::sync::atomic::Ordering::Relaxed), 6);
+        assert_eq!(done.load(std::sync::atomic::Ordering::Relaxed), 7);
         let problems = super::super::read_split(&dir).unwrap();
         assert_eq!(problems.len(), 2);
         assert_eq!(problems[1].metadata.steps, Some(25));
