@@ -115,10 +115,14 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
     }
     first.kill().ok();
     first.wait().unwrap();
+    // What a write killed mid-way leaves (the dead process's temporary file) is swept on resume.
+    let killed_write = run.join(format!(".training_state.json.{}-0.tmp", first.id()));
+    std::fs::write(&killed_write, "").unwrap();
     // The same command resumes from the newest checkpoint and finishes.
     let output = train().output().unwrap();
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     assert!(run.join("model/model.safetensors").exists());
+    assert!(!killed_write.exists(), "the killed write's temporary is removed");
     let log = std::fs::read_to_string(run.join("train.jsonl")).unwrap();
     let steps: Vec<u64> = log
         .lines()

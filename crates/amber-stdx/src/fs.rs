@@ -108,6 +108,43 @@ fn tmp_path(path: &Path) -> Result<PathBuf, FileError> {
     Ok(path.with_file_name(format!(".{}.{}-{n}.tmp", name.to_string_lossy(), std::process::id())))
 }
 
+/// Removes, under `dir` and its subdirectories, the temporary files of writes whose process is
+/// gone (killed mid-write: `kill -9`, power loss), so that a resumed run does not accumulate them.
+/// A process is gone when `/proc/<pid>` is absent; where there is no `/proc`, nothing is removed.
+/// Returns how many were removed.
+pub fn remove_stale_temporaries(dir: &Path) -> Result<usize, FileError> {
+    if !Path::new("/proc/self").exists() {
+        return Ok(0);
+    }
+    let mut removed = 0;
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(0),
+        Err(e) => return Err(FileError::io(dir)(e)),
+    };
+    for entry in entries {
+        let entry = entry.map_err(FileError::io(dir))?;
+        let path = entry.path();
+        if entry.file_type().map_err(FileError::io(&path))?.is_dir() {
+            removed += remove_stale_temporaries(&path)?;
+        } else if let Some(pid) = temporary_owner(&entry.file_name().to_string_lossy())
+            && !Path::new("/proc").join(pid.to_string()).exists()
+        {
+            std::fs::remove_file(&path).map_err(FileError::io(&path))?;
+            removed += 1;
+        }
+    }
+    Ok(removed)
+}
+
+/// The pid in the name of a temporary file of [`tmp_path`] (`.name.<pid>-<n>.tmp`).
+fn temporary_owner(file_name: &str) -> Option<u32> {
+    let stem = file_name.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let (pid, n) = stem.rsplit_once('.')?.1.split_once('-')?;
+    n.parse::<usize>().ok()?;
+    pid.parse().ok()
+}
+
 /// Makes the complete temporary file durable and puts it in place.
 fn commit(tmp: &Path, path: &Path) -> Result<(), FileError> {
     File::open(tmp).and_then(|f| f.sync_all()).map_err(FileError::io(path))?;
@@ -173,6 +210,23 @@ mod tests {
         assert!(matches!(err, FileError::Json { .. }) && err.to_string().contains("bad.json"), "{err}");
         assert!(matches!(read_json::<serde_json::Value>(&missing_dir), Err(FileError::Io { .. })));
         assert!(matches!(write_atomic(Path::new("/"), b"x"), Err(FileError::Io { .. })));
+    }
+
+    #[test]
+    fn temporaries_of_dead_processes_are_removed_and_others_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("checkpoints/step-00000010");
+        std::fs::create_dir_all(&sub).unwrap();
+        // pid 2^22 + 1 is above Linux's pid_max: never a live process.
+        let dead = [dir.path().join(".state.json.4194305-0.tmp"), sub.join(".model.safetensors.4194305-17.tmp")];
+        let live = dir.path().join(format!(".log.jsonl.{}-3.tmp", std::process::id()));
+        let kept = [live, dir.path().join("state.json"), dir.path().join(".hidden.tmp"), sub.join("x.4194305-1.tmp")];
+        for path in dead.iter().chain(&kept) {
+            std::fs::write(path, "").unwrap();
+        }
+        assert_eq!(remove_stale_temporaries(dir.path()).unwrap(), 2);
+        assert!(dead.iter().all(|p| !p.exists()) && kept.iter().all(|p| p.exists()));
+        assert_eq!(remove_stale_temporaries(&dir.path().join("missing")).unwrap(), 0);
     }
 
     #[test]

@@ -9,5 +9,8 @@
 mod fs;
 mod stats;
 
-pub use fs::{FileError, read_json, write_atomic, write_atomic_via, write_atomic_with, write_json_atomic};
+pub use fs::{
+    FileError, read_json, remove_stale_temporaries, write_atomic, write_atomic_via, write_atomic_with,
+    write_json_atomic,
+};
 pub use stats::{median, quantile};

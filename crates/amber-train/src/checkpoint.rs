@@ -150,8 +150,10 @@ impl TrainingState {
 }
 
 /// The directory of the newest complete checkpoint under `out_dir`, if any. `latest` must name
-/// a checkpoint of this run (`step-NNNNNNNN`), never a path elsewhere.
+/// a checkpoint of this run (`step-NNNNNNNN`), never a path elsewhere. Every run is opened
+/// through here, so this is where the temporary files of writes killed mid-way are removed.
 pub fn latest_checkpoint(out_dir: &Path) -> Result<Option<PathBuf>> {
+    amber_stdx::remove_stale_temporaries(out_dir)?;
     let root = out_dir.join(CHECKPOINTS_DIR);
     let latest = root.join(LATEST_FILE);
     match std::fs::read_to_string(&latest) {
