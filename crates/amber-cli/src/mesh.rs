@@ -237,11 +237,33 @@ impl Picture for Mesh3 {
     }
 }
 
-/// Writes `mesh` to `output` by extension, with its element sizes; `.png` is a picture.
+/// Elements whose smallest angle (2D) or dihedral angle (3D) is below this many degrees are
+/// reported: a solver's stiffness matrix degrades with them, and some solvers refuse them.
+const DEGENERATE_ANGLE_DEGREES: f64 = 5.0;
+
+/// The smallest angle of `mesh` (dihedral in 3D) and how many elements have one below
+/// [`DEGENERATE_ANGLE_DEGREES`].
+fn degenerate_elements<const D: usize>(mesh: &Mesh<D>) -> (f64, usize) {
+    let angles = mesh.min_angles();
+    let smallest = angles.iter().copied().fold(f64::INFINITY, f64::min);
+    (smallest, angles.iter().filter(|&&a| a < DEGENERATE_ANGLE_DEGREES).count())
+}
+
+/// Writes `mesh` to `output` by extension, with its element sizes; `.png` is a picture. Says
+/// how well shaped the mesh is, with a warning when elements are nearly degenerate.
 fn write_output<const D: usize>(mesh: &Mesh<D>, output: &Path) -> anyhow::Result<()>
 where
     Mesh<D>: Picture,
 {
+    let (smallest, degenerate) = degenerate_elements(mesh);
+    let angle = if D == 2 { "angle" } else { "dihedral angle" };
+    eprintln!("smallest {angle} {smallest:.1}°");
+    if degenerate > 0 {
+        eprintln!(
+            "warning: {degenerate} of {} elements have an {angle} below {DEGENERATE_ANGLE_DEGREES}° (nearly degenerate)",
+            mesh.num_elements()
+        );
+    }
     let sizes = mesh.sizes();
     match output.extension().and_then(|e| e.to_str()) {
         Some("png") => {
@@ -282,12 +304,11 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     write_output(&mesh, &args.output)?;
     eprintln!(
-        "{} triangles in {seconds:.3} s; size ratio median {:.3} (p10 {:.3}, p90 {:.3}); min angle {:.1}°, mean min angle {:.1}°; wrote {}",
+        "{} triangles in {seconds:.3} s; size ratio median {:.3} (p10 {:.3}, p90 {:.3}); mean smallest angle {:.1}°; wrote {}",
         mesh.num_elements(),
         report.size_ratio_median,
         report.size_ratio_p10,
         report.size_ratio_p90,
-        report.min_angle,
         report.mean_min_angle,
         args.output.display()
     );
@@ -340,4 +361,21 @@ fn read_sizing_mesh(path: &Path) -> anyhow::Result<(Mesh2, Vec<f64>)> {
         );
     }
     Ok((mesh, sizes))
+}
+
+#[cfg(test)]
+mod tests {
+    use amber_mesh::Mesh2;
+
+    use super::*;
+
+    #[test]
+    fn slivers_are_counted_as_degenerate() {
+        // A right triangle (45°) and an isosceles sliver with base angles of 1°.
+        let sliver = [[3.0, 0.0], [5.0, 0.0], [4.0, 1.0f64.to_radians().tan()]];
+        let vertices = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]].into_iter().chain(sliver).collect();
+        let mesh = Mesh2::new(vertices, vec![0, 1, 2, 3, 4, 5]).unwrap();
+        let (smallest, degenerate) = degenerate_elements(&mesh);
+        assert!((smallest - 1.0).abs() < 1e-9 && degenerate == 1, "{smallest}° {degenerate}");
+    }
 }
