@@ -18,8 +18,8 @@ mod mesh;
 pub use adjacency::FacetAdjacency;
 pub use error::MeshError;
 pub use io::{
-    AnyMesh, Encoding, MeshData, StlFaceIds, TriangleSoup, parse_any_mesh, parse_surface, read_any_mesh, read_mesh,
-    read_mesh_with_data, read_surface, write_mesh, write_mesh_as,
+    AnyMesh, Encoding, MESH_FORMATS, MeshData, StlFaceIds, TriangleSoup, parse_any_mesh, parse_surface, read_any_mesh,
+    read_mesh, read_mesh_with_data, read_surface, write_mesh, write_mesh_as,
 };
 pub use locate::{Location, PointLocator};
-pub use mesh::{Mesh, Mesh2, Mesh3, centroid, signed_volume, size_from_volume, volume_from_size};
+pub use mesh::{Mesh, Mesh2, Mesh3, bounding_box, centroid, signed_volume, size_from_volume, volume_from_size};

@@ -135,14 +135,7 @@ impl<const D: usize> Mesh<D> {
 
     /// Axis-aligned bounding box `(min, max)` of the vertices; `None` for an empty mesh.
     pub fn bounding_box(&self) -> Option<([f64; D], [f64; D])> {
-        let first = *self.vertices.first()?;
-        Some(self.vertices.iter().fold((first, first), |(mut lo, mut hi), p| {
-            for k in 0..D {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-            (lo, hi)
-        }))
+        bounding_box(&self.vertices)
     }
 
     /// Minimum interior angle of each triangle in degrees (2D), or minimum dihedral angle of
@@ -155,6 +148,18 @@ impl<const D: usize> Mesh<D> {
             })
             .collect()
     }
+}
+
+/// Axis-aligned bounding box `(min, max)` of `points`; `None` when there are none.
+pub fn bounding_box<const D: usize>(points: &[[f64; D]]) -> Option<([f64; D], [f64; D])> {
+    let first = *points.first()?;
+    Some(points.iter().fold((first, first), |(mut lo, mut hi), p| {
+        for k in 0..D {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+        (lo, hi)
+    }))
 }
 
 /// Signed volume of the simplex formed by `cell` (positive for positive orientation).

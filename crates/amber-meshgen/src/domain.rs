@@ -122,9 +122,7 @@ impl PolygonDomain {
 
     /// Axis-aligned bounding box `(min, max)`.
     pub fn bounding_box(&self) -> ([f64; 2], [f64; 2]) {
-        self.outer.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), p| {
-            ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])])
-        })
+        amber_mesh::bounding_box(&self.outer).expect("a validated domain's outer ring has at least 3 vertices")
     }
 
     fn validate(&self) -> Result<(), MeshgenError> {

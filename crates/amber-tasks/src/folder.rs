@@ -19,7 +19,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use amber_mesh::{Mesh, MeshError, read_mesh};
+use amber_mesh::{MESH_FORMATS, Mesh, MeshError, read_mesh};
 use amber_stdx::{median, read_json};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -49,6 +49,12 @@ pub const INITIAL_SIZE_FACTOR: f64 = 4.0;
 /// another part, or in other units, differs by far more; a faceted CAD surface and its mesh by
 /// far less.
 const VOLUME_TOLERANCE: f64 = 0.01;
+
+/// The corners of the geometry's and the mesh's bounding boxes may lie this fraction of the
+/// mesh's box diagonal apart: a part of about the same volume placed elsewhere or shaped
+/// otherwise moves them by far more, while Console's expert meshes and their reference
+/// surfaces differ by at most 0.19 % (train/006).
+const BOX_TOLERANCE: f64 = 0.01;
 
 /// A split of a dataset folder.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -195,7 +201,8 @@ fn find_geometry(dir: &Path, stem: &str, files: &[PathBuf], mesh: &Path, dimensi
 /// The dimension of the meshes in the split directory `dir`: that of its first expert mesh (the
 /// others must match when read).
 pub fn mesh_dimension(dir: &Path) -> Result<usize, TaskError> {
-    for files in part_files(dir)?.values() {
+    let files = part_files(dir)?;
+    for files in files.values() {
         let (json, others): (Vec<&PathBuf>, Vec<&PathBuf>) = files.iter().partition(|p| extension(p) == "json");
         for path in others.into_iter().chain(json) {
             match read_mesh::<3>(path) {
@@ -206,7 +213,16 @@ pub fn mesh_dimension(dir: &Path) -> Result<usize, TaskError> {
             }
         }
     }
-    Err(TaskError::Dataset { path: dir.into(), message: "no expert mesh in this split".into() })
+    Err(no_expert_mesh(dir, files.values().map(Vec::len).sum()))
+}
+
+/// The error of the split directory `dir` holding `files` files, none of them a mesh.
+fn no_expert_mesh(dir: &Path, files: usize) -> TaskError {
+    let message = match files {
+        0 => "the split directory is empty: no expert mesh".to_owned(),
+        n => format!("no expert mesh in this split: none of its {n} files is a mesh amber reads ({MESH_FORMATS})"),
+    };
+    TaskError::Dataset { path: dir.into(), message }
 }
 
 /// Reads the expert meshes of the split directory `dir` (at most `limit` parts, the first by
@@ -235,7 +251,7 @@ pub fn read_experts<const D: usize>(dir: &Path, limit: Option<usize>) -> Result<
         experts.extend(read.into_iter().flatten());
     }
     if experts.is_empty() {
-        return Err(TaskError::Dataset { path: dir.into(), message: "no expert mesh in this split".into() });
+        return Err(no_expert_mesh(dir, stems.iter().map(|(_, files)| files.len()).sum()));
     }
     Ok(experts)
 }
@@ -254,20 +270,39 @@ pub trait FolderDomain<const D: usize>: Domain<D> + Sized + Send {
     fn from_expert(expert: &Expert<D>, initial_size: f64, settings: &DatasetSettings) -> Result<Self, TaskError>;
 }
 
-/// The error of a geometry whose enclosed volume (area) differs from its expert mesh's.
-fn check_volume<const D: usize>(expert: &Expert<D>, geometry: f64) -> Result<(), TaskError> {
-    let mesh = expert.mesh.total_volume();
-    match &expert.geometry {
-        Some(path) if (geometry / mesh - 1.0).abs() > VOLUME_TOLERANCE => Err(TaskError::Dataset {
-            path: path.clone(),
-            message: format!(
-                "encloses {} {geometry:.6e}, but the expert mesh {} covers {mesh:.6e}: not the geometry of this mesh",
-                if D == 3 { "volume" } else { "area" },
-                expert.path.display()
-            ),
-        }),
-        _ => Ok(()),
+/// The error of a geometry file that is not its expert mesh's: its bounding box `bounds` lies
+/// elsewhere, or its enclosed volume (area) `volume` differs.
+fn check_geometry<const D: usize>(
+    expert: &Expert<D>,
+    bounds: ([f64; D], [f64; D]),
+    volume: f64,
+) -> Result<(), TaskError> {
+    let Some(path) = &expert.geometry else { return Ok(()) };
+    let mismatch = |what: String| {
+        let message = format!("{what}: not the geometry of the expert mesh {}", expert.path.display());
+        Err(TaskError::Dataset { path: path.clone(), message })
+    };
+    let mesh_volume = expert.mesh.total_volume();
+    if (volume / mesh_volume - 1.0).abs() > VOLUME_TOLERANCE {
+        let what = if D == 3 { "volume" } else { "area" };
+        return mismatch(format!("encloses {what} {volume:.6e}, but the mesh covers {mesh_volume:.6e}"));
     }
+    let Some(mesh_bounds) = expert.mesh.bounding_box() else { return Ok(()) };
+    let diagonal = (0..D).map(|k| (mesh_bounds.1[k] - mesh_bounds.0[k]).powi(2)).sum::<f64>().sqrt();
+    let offset = (0..D)
+        .map(|k| (bounds.0[k] - mesh_bounds.0[k]).abs().max((bounds.1[k] - mesh_bounds.1[k]).abs()))
+        .fold(0.0, f64::max);
+    if offset > BOX_TOLERANCE * diagonal {
+        return mismatch(format!(
+            "bounding box {:?}–{:?} is {offset:.4e} away from the mesh's {:?}–{:?} (tolerance {:.4e})",
+            bounds.0,
+            bounds.1,
+            mesh_bounds.0,
+            mesh_bounds.1,
+            BOX_TOLERANCE * diagonal
+        ));
+    }
+    Ok(())
 }
 
 /// The error of an M⁰ that could not be meshed.
@@ -282,7 +317,8 @@ impl FolderDomain<3> for SolidPart {
             Some(path) => read_solid_surface(path, settings.feature_angle())?,
             None => solid_surface_of_mesh(&expert.path, &expert.mesh, settings.feature_angle())?,
         };
-        check_volume(expert, surface.enclosed_volume())?;
+        let bounds = amber_mesh::bounding_box(surface.vertices()).expect("a validated surface has vertices");
+        check_geometry(expert, bounds, surface.enclosed_volume())?;
         SolidPart::new(expert.name.clone(), surface, initial_size).map_err(|e| initial_mesh_error(expert, e))
     }
 }
@@ -293,7 +329,7 @@ impl FolderDomain<2> for PlanarPart {
             Some(path) => read_polygon_domain(path)?,
             None => polygon_domain_of_mesh(&expert.path, &expert.mesh)?,
         };
-        check_volume(expert, domain.area())?;
+        check_geometry(expert, domain.bounding_box(), domain.area())?;
         PlanarPart::new(expert.name.clone(), domain, initial_size).map_err(|e| initial_mesh_error(expert, e))
     }
 }
@@ -423,7 +459,7 @@ mod tests {
         let experts = read_experts::<2>(&train, None).unwrap();
         assert_eq!(experts[0].geometry.as_deref(), Some(train.join("plate00.json").as_path()));
         let err = message(problems::<2, PlanarPart>(experts, 0.2, &DatasetSettings::default()).unwrap_err());
-        assert!(err.contains("plate00.json") && err.contains("not the geometry of this mesh"), "{err}");
+        assert!(err.contains("plate00.json") && err.contains("not the geometry of the expert mesh"), "{err}");
         std::fs::remove_file(train.join("plate00.json")).unwrap();
 
         // A mesh that does not parse.
@@ -443,6 +479,132 @@ mod tests {
         std::fs::write(dir.join(SETTINGS_FILE), r#"{"initial_size": -1}"#).unwrap();
         let err = message(DatasetSettings::read(&dir).unwrap_err());
         assert!(err.contains(SETTINGS_FILE), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The unit cube shifted by `offset`, as 6 tets (Kuhn's split along the main diagonal).
+    fn cube_tets(offset: [f64; 3]) -> Mesh<3> {
+        let vertices = (0..8).map(|i| [0, 1, 2].map(|k| ((i >> k) & 1) as f64 + offset[k])).collect();
+        let cells = [[1, 3], [1, 5], [2, 3], [2, 6], [4, 5], [4, 6]].iter().flat_map(|&[a, b]| [0, a, b, 7]).collect();
+        Mesh::new_reoriented(vertices, cells).unwrap()
+    }
+
+    /// Writes the boundary of `mesh` as an ASCII STL file.
+    fn write_boundary_stl(mesh: &Mesh<3>, path: &Path) {
+        let surface = amber_meshgen::mesh3d::Surface::from_mesh_boundary(mesh).unwrap();
+        let mut stl = String::from("solid part\n");
+        for t in surface.triangles() {
+            stl += "facet normal 0 0 0\nouter loop\n";
+            for &v in t {
+                let [x, y, z] = surface.vertices()[v as usize];
+                stl += &format!("vertex {x} {y} {z}\n");
+            }
+            stl += "endloop\nendfacet\n";
+        }
+        std::fs::write(path, stl + "endsolid part\n").unwrap();
+    }
+
+    /// A 3D folder of `.vtk` experts without geometry files: each part's geometry is its mesh's
+    /// boundary, split into faces at feature edges, and M⁰ fills it.
+    #[test]
+    fn a_solid_folder_without_geometry_files_loads() {
+        let dir = temp_dir("solid");
+        let train = Split::Train.dir(&dir);
+        std::fs::create_dir_all(&train).unwrap();
+        amber_mesh::write_mesh(&cube_tets([0.0; 3]), train.join("cube.vtk"), &amber_mesh::MeshData::default()).unwrap();
+        assert_eq!(mesh_dimension(&train).unwrap(), 3);
+        let experts = read_experts::<3>(&train, None).unwrap();
+        assert!(experts[0].geometry.is_none());
+        let part = problems::<3, SolidPart>(experts, 0.25, &DatasetSettings::default()).unwrap().pop().unwrap();
+        assert_eq!(part.domain.surface.face_ids().iter().max(), Some(&6));
+        assert!((part.initial_mesh().total_volume() - 1.0).abs() < 1e-12);
+        assert!(part.initial_mesh().num_elements() > 50);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A surface of another part beside a mesh is named, whether its volume differs (a larger
+    /// cube) or only its place (the same cube moved by half its side).
+    #[test]
+    fn a_surface_of_another_part_is_named() {
+        let dir = temp_dir("other-part");
+        let train = Split::Train.dir(&dir);
+        std::fs::create_dir_all(&train).unwrap();
+        amber_mesh::write_mesh(&cube_tets([0.0; 3]), train.join("cube.vtk"), &amber_mesh::MeshData::default()).unwrap();
+        let stl = train.join("cube.stl");
+        let load = || problems::<3, SolidPart>(read_experts(&train, None)?, 0.25, &DatasetSettings::default());
+        write_boundary_stl(&cube_tets([0.0; 3]), &stl);
+        assert!(load().is_ok());
+        write_boundary_stl(&cube_tets([0.5, 0.0, 0.0]), &stl);
+        let err = load().unwrap_err().to_string();
+        assert!(err.contains("cube.stl") && err.contains("cube.vtk") && err.contains("bounding box"), "{err}");
+        let larger = cube_tets([0.0; 3]);
+        let larger = Mesh::new(larger.vertices().iter().map(|p| p.map(|x| 1.1 * x)).collect(), larger.cells().to_vec());
+        write_boundary_stl(&larger.unwrap(), &stl);
+        let err = load().unwrap_err().to_string();
+        assert!(err.contains("cube.stl") && err.contains("encloses volume"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The errors of splits that hold no expert mesh say whether the directory is empty or its
+    /// files are no meshes; a 3D split in a 2D dataset and a truncated binary mesh are named.
+    #[test]
+    fn splits_without_meshes_and_broken_meshes_are_named() {
+        let dir = temp_dir("splits");
+        write_demo_dataset(&dir, 5).unwrap();
+        let empty = dir.join("empty");
+        std::fs::create_dir_all(&empty).unwrap();
+        let err = read_experts::<2>(&empty, None).unwrap_err().to_string();
+        assert!(err.contains("empty") && err.contains("is empty"), "{err}");
+        let err = mesh_dimension(&empty).unwrap_err().to_string();
+        assert!(err.contains("is empty"), "{err}");
+        std::fs::write(empty.join("part.step"), "ISO-10303-21;").unwrap();
+        std::fs::write(empty.join("notes.txt"), "no meshes here").unwrap();
+        let err = read_experts::<2>(&empty, None).unwrap_err().to_string();
+        assert!(err.contains("none of its 2 files is a mesh"), "{err}");
+
+        // Mixed dimensions across splits: the dataset is 2D (train), val holds tets.
+        let val = Split::Val.dir(&dir);
+        std::fs::remove_dir_all(&val).unwrap();
+        std::fs::create_dir_all(&val).unwrap();
+        amber_mesh::write_mesh(&cube_tets([0.0; 3]), val.join("cube.vtk"), &amber_mesh::MeshData::default()).unwrap();
+        assert_eq!(mesh_dimension(&Split::Train.dir(&dir)).unwrap(), 2);
+        let err = read_experts::<2>(&val, None).unwrap_err().to_string();
+        assert!(err.contains("cube.vtk") && err.contains("mixed dimensions"), "{err}");
+
+        // A binary mesh cut short.
+        let test = Split::Test.dir(&dir);
+        let plate: Mesh<2> = read_mesh(test.join("plate00.msh")).unwrap();
+        let binary = test.join("plate00.msh");
+        amber_mesh::write_mesh_as(
+            &plate,
+            &binary,
+            &amber_mesh::MeshData::default(),
+            Some(amber_mesh::Encoding::Binary),
+        )
+        .unwrap();
+        let bytes = std::fs::read(&binary).unwrap();
+        std::fs::write(&binary, &bytes[..bytes.len() / 2]).unwrap();
+        let err = read_experts::<2>(&test, None).unwrap_err().to_string();
+        assert!(err.contains("plate00.msh"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Console's val/001 expert (reads `../shared/data/console`) with no geometry file: its own
+    /// boundary is the geometry. The uniform M⁰ once failed: the near-coplanar vertices of its
+    /// planar faces made a flat tet in TetGen's background mesh.
+    #[test]
+    fn a_console_expert_without_its_surface_loads() {
+        let Some(data) = amber_testdata::shared("data/console") else { return };
+        let dir = temp_dir("console-boundary");
+        let val = Split::Val.dir(&dir);
+        std::fs::create_dir_all(&val).unwrap();
+        std::fs::copy(data.join("val/001.nas"), val.join("001.nas")).unwrap();
+        let experts = read_experts::<3>(&val, None).unwrap();
+        assert!(experts[0].geometry.is_none());
+        let size = crate::console::INITIAL_SIZE;
+        let part = problems::<3, SolidPart>(experts, size, &DatasetSettings::default()).unwrap().pop().unwrap();
+        let (m0, expert) = (part.initial_mesh(), part.expert_mesh());
+        assert!((m0.total_volume() / expert.total_volume() - 1.0).abs() < 5e-3, "{}", m0.total_volume());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

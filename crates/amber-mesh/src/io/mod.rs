@@ -110,7 +110,8 @@ enum Format {
     Medit,
 }
 
-const FORMATS: &str = ".vtu, .vtk, .msh, .json, .nas, .inp, .mesh";
+/// The extensions of the mesh files amber reads and writes, for messages.
+pub const MESH_FORMATS: &str = ".vtu, .vtk, .msh, .json, .nas, .inp, .mesh";
 
 fn format_of(path: &Path) -> Option<Format> {
     let ext = path.extension()?.to_str()?.to_ascii_lowercase();
@@ -197,8 +198,8 @@ enum Parsed {
 }
 
 fn parse_raw(path: &Path, bytes: Vec<u8>) -> Result<Parsed, MeshError> {
-    let format =
-        format_of(path).ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: FORMATS })?;
+    let format = format_of(path)
+        .ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: MESH_FORMATS })?;
     Ok(Parsed::Raw(match format {
         Format::Json => return Ok(Parsed::Json(bytes)),
         Format::Vtu => vtu::read(path, &bytes)?,
@@ -319,8 +320,8 @@ pub fn write_mesh_as<const D: usize>(
     encoding: Option<Encoding>,
 ) -> Result<(), MeshError> {
     let path = path.as_ref();
-    let format =
-        format_of(path).ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: FORMATS })?;
+    let format = format_of(path)
+        .ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: MESH_FORMATS })?;
     data.check_lengths(path, mesh.num_elements(), mesh.num_vertices())?;
     let binary = match (format, encoding) {
         (Format::Vtu, None) | (_, Some(Encoding::Binary)) => true,

@@ -15,7 +15,7 @@ use rstar::primitives::GeomWithData;
 
 use super::remesh::{RemeshError, RemeshParams, remesh};
 use super::surface::{Surface, SurfaceDefect};
-use super::tetgen::{Quality, TetgenError, TetgenSwitches, delaunay, tetrahedralize};
+use super::tetgen::{Quality, TetgenError, TetgenSwitches, convex_background, tetrahedralize};
 use crate::SizingField;
 use amber_mesh::Mesh3;
 
@@ -176,12 +176,12 @@ pub fn fill_surface(
         .iter()
         .map(|&p| checked_size(field, p).map(|h| params.size_factor * h))
         .collect::<Result<Vec<_>, _>>()?;
-    let (background, background_sizes) = background_mesh(surface, &sizes)?;
+    let background = convex_background(surface.vertices(), &sizes, BACKGROUND_PADDING)?;
     // TetGen's Steiner-point cap: a mesh with `max_elements` tets has far fewer points, so
     // reaching it means the cap is exceeded.
     let switches = TetgenSwitches { max_steiner_points: Some(params.max_elements), ..params.switches };
     let plc = surface.to_plc();
-    let background = Some((&background, &background_sizes[..]));
+    let background = Some(&background);
     let mut out = tetrahedralize(&plc, Some(&sizes), background, &switches);
     for quality in FALLBACK_QUALITY {
         match out {
@@ -204,6 +204,10 @@ pub fn fill_surface(
     Ok(out.mesh)
 }
 
+/// The background mesh's box is the surface's grown by this fraction of its diagonal on every
+/// side, so that no point TetGen creates falls outside it.
+const BACKGROUND_PADDING: f64 = 0.1;
+
 /// Looser quality bounds for TetGen, tried in turn when its refinement fails with an internal
 /// error: it rarely does with `-q1.4/20` on a remeshed surface (1 of 105 Console meshes with
 /// varied fields), and never so far with 1.5/18°.
@@ -215,32 +219,6 @@ const FALLBACK_QUALITY: [Quality; 2] = [
 fn checked_size(field: &impl SizingField<3>, p: [f64; 3]) -> Result<f64, Mesh3dError> {
     let h = field.size_at(p);
     if h.is_finite() && h > 0.0 { Ok(h) } else { Err(Mesh3dError::InvalidSize { at: p, value: h }) }
-}
-
-/// The convex background mesh for TetGen's `-m`: the Delaunay tetrahedralisation of the
-/// surface vertices and the corners of their bounding box grown by a tenth of its diagonal,
-/// with the surface sizes at the vertices and the nearest vertex's size at each corner.
-fn background_mesh(surface: &Surface, sizes: &[f64]) -> Result<(Mesh3, Vec<f64>), Mesh3dError> {
-    let points = surface.vertices();
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let padding = 0.1 * (Vector3::from(hi) - Vector3::from(lo)).norm();
-    let tree = RTree::bulk_load(points.iter().enumerate().map(|(i, &p)| GeomWithData::new(p, i)).collect());
-    let mut all = points.to_vec();
-    let mut all_sizes = sizes.to_vec();
-    for c in 0..8 {
-        let corner = [0, 1, 2].map(|k| if c >> k & 1 == 0 { lo[k] - padding } else { hi[k] + padding });
-        let nearest = tree.nearest_neighbor(corner).map_or(0, |n| n.data);
-        all.push(corner);
-        all_sizes.push(sizes[nearest]);
-    }
-    Ok((delaunay(&all)?, all_sizes))
 }
 
 /// A field scaled by a factor and capped by the curvature of the reference surface: at a point whose nearest

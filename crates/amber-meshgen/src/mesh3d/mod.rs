@@ -17,7 +17,8 @@ pub use generate::{Mesh3dError, Mesh3dParams, adapt_surface, fill_surface, gener
 pub use remesh::{RemeshError, RemeshParams, remesh};
 pub use surface::{StlFaceIds, Surface, SurfaceDefect, SurfaceError, SurfaceReport};
 pub use tetgen::{
-    Optimization, Plc, Quality, TetgenError, TetgenMesh, TetgenSwitches, convex_background, delaunay, tetrahedralize,
+    BackgroundMesh, Optimization, Plc, Quality, TetgenError, TetgenMesh, TetgenSwitches, convex_background, delaunay,
+    tetrahedralize,
 };
 
 /// The shipped Console reference surfaces (19 train + 2 val), or `None` when the data is absent.

@@ -5,12 +5,18 @@
 //! surface handed in, so the surface must already follow the sizing field (spec §2, 3D).
 //! Linking this module makes the program AGPL-3.0 (see `crates/tetgen-sys/tetgen/NOTICE.md`).
 
+use std::cmp::Ordering;
 use std::collections::HashMap;
 use std::ffi::{CString, c_int};
 use std::ptr::{null, null_mut};
 
-use amber_mesh::{Mesh3, MeshError, signed_volume};
+use amber_mesh::{Mesh3, MeshError, bounding_box, signed_volume};
+use nalgebra::Vector3;
+use rstar::RTree;
+use rstar::primitives::GeomWithData;
 use tetgen_sys as sys;
+
+use super::predicates::orient3d;
 
 /// A piecewise linear complex made of triangles: every triangle is one facet of TetGen's input,
 /// carrying a marker (the CAD face id) that reappears on the output boundary triangles.
@@ -181,17 +187,34 @@ pub enum TetgenError {
     /// TetGen's output is not a valid positively oriented mesh.
     #[error("TetGen's output is not a valid mesh: {0}")]
     InvalidOutput(#[from] MeshError),
+    /// A tet of TetGen's Delaunay tetrahedralisation is flat or inverted in exact arithmetic.
+    #[error("TetGen's Delaunay tet {tet} is not positively oriented")]
+    InvertedDelaunayTet { tet: usize },
+}
+
+/// TetGen's background mesh for `-m` (spec §2, 3D): a convex tet mesh with a target edge length
+/// at every node, in which TetGen locates every point it creates to size it.
+///
+/// Not a [`Mesh3`]: its tets are a Delaunay tetrahedralisation (see [`delaunay`]), which may hold
+/// flat tets that only exact arithmetic tells positive. They are harmless here: TetGen walks the
+/// background mesh with its own exact predicates and interpolates within whichever tet holds a
+/// point.
+#[derive(Clone, Debug)]
+pub struct BackgroundMesh {
+    points: Vec<[f64; 3]>,
+    tets: Vec<[u32; 4]>,
+    sizes: Vec<f64>,
 }
 
 /// Tetrahedralises the closed surface `plc`.
 ///
-/// `point_sizes` (one target edge length per PLC point) and the `background` mesh with nodal
-/// sizes drive TetGen's `-m`; new points take their size from the background mesh when there
-/// is one (TetGen locates them in it, so it should be convex), else from the surface sizes.
+/// `point_sizes` (one target edge length per PLC point) and the `background` mesh drive TetGen's
+/// `-m`; new points take their size from the background mesh when there is one, else from the
+/// surface sizes.
 pub fn tetrahedralize(
     plc: &Plc,
     point_sizes: Option<&[f64]>,
-    background: Option<(&Mesh3, &[f64])>,
+    background: Option<&BackgroundMesh>,
     switches: &TetgenSwitches,
 ) -> Result<TetgenMesh, TetgenError> {
     let n = plc.points.len();
@@ -207,22 +230,19 @@ pub fn tetrahedralize(
         check_len("point_sizes", n, sizes.len())?;
         check_sizes("point", sizes)?;
     }
-    if let Some((mesh, sizes)) = background {
-        check_len("background sizes", mesh.num_vertices(), sizes.len())?;
-        check_sizes("background node", sizes)?;
-        to_int(mesh.num_vertices(), "background points")?;
-        to_int(mesh.num_elements(), "background tets")?;
+    if let Some(background) = background {
+        to_int(background.tets.len(), "background tets")?;
     }
     let command = switches.to_command(point_sizes.is_some() || background.is_some())?;
     let triangles: Vec<c_int> = plc.triangles.iter().flatten().map(|&v| v as c_int).collect();
-    let bg_tets: Vec<c_int> = background.map_or(Vec::new(), |(m, _)| m.cells().iter().map(|&v| v as c_int).collect());
-    let bg_points = background.map_or(&[][..], |(m, _)| m.vertices());
+    let bg_tets: Vec<c_int> = background.map_or(Vec::new(), |b| b.tets.iter().flatten().map(|&v| v as c_int).collect());
+    let bg_points = background.map_or(&[][..], |b| &b.points);
     let out = run(
         &command,
         &plc.points,
         (&triangles, &plc.face_markers),
         point_sizes,
-        (bg_points, &bg_tets, background.map(|(_, s)| s)),
+        (bg_points, &bg_tets, background.map(|b| &b.sizes[..])),
     )?;
     if out.tets.is_empty() {
         return Err(TetgenError::NoTets);
@@ -235,35 +255,54 @@ pub fn tetrahedralize(
     Ok(TetgenMesh { mesh, boundary, boundary_markers })
 }
 
-/// Delaunay tetrahedralisation of the convex hull of `points` (no `p` switch); the mesh's
-/// vertices are `points` in their order (duplicate points are an error).
-pub fn delaunay(points: &[[f64; 3]]) -> Result<Mesh3, TetgenError> {
+/// Delaunay tetrahedralisation of the convex hull of `points` (no `p` switch): tets over
+/// `points` in their order (duplicate points are an error), each positively oriented in exact
+/// arithmetic.
+///
+/// Not a [`Mesh3`]: points that are coplanar up to the rounding of their coordinates and nearly
+/// cocircular (a rectangle of vertices on a planar face of a mesh boundary read from a file)
+/// make flat Delaunay tets, of volume far below the rounding error of a floating-point
+/// determinant, whose computed volume may come out zero or negative.
+pub fn delaunay(points: &[[f64; 3]]) -> Result<Vec<[u32; 4]>, TetgenError> {
     check_points(points)?;
     let out = run("Q", points, (&[], &[]), None, (&[], &[], None))?;
     keeps_input_points(points, &out.points)?;
-    Ok(Mesh3::new(out.points, out.tets)?)
+    let tets: Vec<[u32; 4]> = out.tets.chunks_exact(4).map(|t| [t[0], t[1], t[2], t[3]]).collect();
+    let inverted = |t: &[u32; 4]| {
+        let [a, b, c, d] = t.map(|v| points[v as usize]);
+        orient3d(a, b, c, d) != Ordering::Greater
+    };
+    match tets.iter().position(inverted) {
+        Some(tet) => Err(TetgenError::InvertedDelaunayTet { tet }),
+        None => Ok(tets),
+    }
 }
 
-/// The convex background mesh for `-m` (spec §2, 3D): the Delaunay tetrahedralisation of the
-/// nodes of `mesh` plus the 8 corners of their bounding box grown by `padding` on every side,
-/// with `nodal_sizes` at the nodes and the size of the nearest node at each corner.
+/// The convex background mesh for `-m` (spec §2, 3D): the Delaunay tetrahedralisation of
+/// `points` plus the 8 corners of their bounding box grown by `padding_fraction` times its diagonal on
+/// every side, with `sizes` at the points and the size of the nearest point at each corner.
 ///
 /// TetGen locates every point it creates in the background mesh; with the (non-convex) current
 /// mesh itself, points just outside its curved boundary would get no size.
-pub fn convex_background(mesh: &Mesh3, nodal_sizes: &[f64], padding: f64) -> Result<(Mesh3, Vec<f64>), TetgenError> {
-    check_len("nodal_sizes", mesh.num_vertices(), nodal_sizes.len())?;
-    check_sizes("node", nodal_sizes)?;
-    let Some((lo, hi)) = mesh.bounding_box() else { return Err(TetgenError::FlatInput) };
-    let mut points = mesh.vertices().to_vec();
-    let mut sizes = nodal_sizes.to_vec();
+pub fn convex_background(
+    points: &[[f64; 3]],
+    sizes: &[f64],
+    padding_fraction: f64,
+) -> Result<BackgroundMesh, TetgenError> {
+    check_len("sizes", points.len(), sizes.len())?;
+    check_sizes("point", sizes)?;
+    let Some((lo, hi)) = bounding_box(points) else { return Err(TetgenError::FlatInput) };
+    let padding = padding_fraction * (Vector3::from(hi) - Vector3::from(lo)).norm();
+    let tree = RTree::bulk_load(points.iter().enumerate().map(|(i, &p)| GeomWithData::new(p, i)).collect());
+    let mut all = points.to_vec();
+    let mut all_sizes = sizes.to_vec();
     for c in 0..8 {
         let corner = [0, 1, 2].map(|k| if c >> k & 1 == 0 { lo[k] - padding } else { hi[k] + padding });
-        let distance = |p: &[f64; 3]| (0..3).map(|k| (p[k] - corner[k]).powi(2)).sum::<f64>();
-        let nearest = (0..mesh.num_vertices()).min_by(|&a, &b| distance(&points[a]).total_cmp(&distance(&points[b])));
-        points.push(corner);
-        sizes.push(nearest.map_or(f64::NAN, |v| nodal_sizes[v]));
+        let nearest = tree.nearest_neighbor(corner).map_or(0, |n| n.data);
+        all.push(corner);
+        all_sizes.push(sizes[nearest]);
     }
-    Ok((delaunay(&points)?, sizes))
+    Ok(BackgroundMesh { tets: delaunay(&all)?, points: all, sizes: all_sizes })
 }
 
 struct RawOutput {
@@ -574,19 +613,39 @@ mod tests {
         // graded interior inside the 12-triangle cube with no point sizes at all.
         let grid: Vec<[f64; 3]> =
             (0..125).map(|i| [(i % 5) as f64 / 4.0, ((i / 5) % 5) as f64 / 4.0, (i / 25) as f64 / 4.0]).collect();
-        let grid_mesh = delaunay(&grid).unwrap();
-        assert!((grid_mesh.total_volume() - 1.0).abs() < 1e-12);
         let grid_sizes: Vec<f64> = grid.iter().map(|p| 0.04 + 0.3 * p[0]).collect();
-        let (bg, sizes) = convex_background(&grid_mesh, &grid_sizes, 0.1).unwrap();
-        assert!((bg.total_volume() - 1.2f64.powi(3)).abs() < 1e-12);
-        assert_eq!(&sizes[..125], &grid_sizes[..]);
+        let padding = 0.1 / 3f64.sqrt();
+        let bg = convex_background(&grid, &grid_sizes, padding).unwrap();
+        let volume: f64 = bg.tets.iter().map(|t| signed_volume::<3>(&bg.points, t)).sum();
+        assert!((volume - 1.2f64.powi(3)).abs() < 1e-12, "{volume}");
+        assert_eq!(&bg.sizes[..125], &grid_sizes[..]);
         let (lo, hi) = (grid_sizes[0], grid_sizes[4]);
-        assert_eq!(&sizes[125..], &[lo, hi, lo, hi, lo, hi, lo, hi]);
+        assert_eq!(&bg.sizes[125..], &[lo, hi, lo, hi, lo, hi, lo, hi]);
         let switches = TetgenSwitches { keep_boundary: false, ..TetgenSwitches::default() };
-        let out = tetrahedralize(&cube(1), None, Some((&bg, &sizes)), &switches).unwrap();
+        let out = tetrahedralize(&cube(1), None, Some(&bg), &switches).unwrap();
         let median = |v: Vec<f64>| v[v.len() / 2];
         let (fine, coarse) =
             (median(edge_lengths_near(&out.mesh, 0.0..0.2)), median(edge_lengths_near(&out.mesh, 0.8..1.0)));
         assert!(fine < 0.5 * coarse, "median edge near x=0: {fine}, near x=1: {coarse}");
+    }
+
+    /// Four points of a planar face of the Console part val/001's expert mesh boundary (coplanar
+    /// up to the rounding of their coordinates: y = 1.421e-14 beside 1.4209997e-14) and one
+    /// point off it: their Delaunay tetrahedralisation has a flat tet whose floating-point volume
+    /// is zero or negative. It is accepted (exactly positive), which a `Mesh3` could not be.
+    #[test]
+    fn near_coplanar_points_have_an_exactly_positive_delaunay_tetrahedralisation() {
+        let points = [
+            [-82.6985, 0.8121609, 94.6517185546875],
+            [-80.4094, 1.421e-14, 114.17020201171874],
+            [-80.4094, 1.4209997299286992e-14, 118.07390074218749],
+            [-52.549339386367365, 68.0476114032497, 65.3049786985771],
+            [-82.6985, 0.8121609, 86.844330390625],
+        ];
+        let tets = delaunay(&points).unwrap();
+        let volumes: Vec<f64> = tets.iter().map(|t| signed_volume::<3>(&points, t)).collect();
+        assert!(volumes.iter().any(|&v| v <= 0.0), "{volumes:?}");
+        let cells: Vec<u32> = tets.iter().flatten().copied().collect();
+        assert!(matches!(Mesh3::new(points.to_vec(), cells), Err(MeshError::NonPositiveElement { .. })));
     }
 }
