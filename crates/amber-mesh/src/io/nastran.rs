@@ -163,8 +163,9 @@ fn real(field: &str) -> Option<f64> {
     }
     let explicit = field.replace(['D', 'd'], "E");
     let value = explicit.parse::<f64>().ok().or_else(|| {
-        // The exponent sign is the last sign that is not the leading one.
-        let i = explicit[1..].rfind(['+', '-'])? + 1;
+        // The exponent sign is the last sign that is not the leading character (of any width).
+        let first = explicit.chars().next()?.len_utf8();
+        let i = explicit[first..].rfind(['+', '-'])? + first;
         format!("{}E{}", &explicit[..i], &explicit[i..]).parse().ok()
     })?;
     value.is_finite().then_some(value)
