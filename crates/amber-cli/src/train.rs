@@ -83,7 +83,10 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
     }
     let inference_steps = config.inference_steps;
     let config = MethodConfig::Amber(config);
-    config.validate()?;
+    config.validate().with_context(|| match &args.config {
+        Some(path) => format!("{}: with the {} profile", path.display(), args.profile),
+        None => format!("the {} profile", args.profile),
+    })?;
     let (seconds, initial_size, data) = match dimension {
         None => {
             let label = format!("{} {} seed {}", args.method, args.difficulty, args.seed);

@@ -85,7 +85,10 @@ impl PolygonDomain {
             rings.push(drop_straight_vertices(ring.iter().map(|&v| mesh.vertices()[v as usize]).collect()));
         }
         let outer = (0..rings.len()).max_by(|&a, &b| ring_area(&rings[a]).total_cmp(&ring_area(&rings[b])));
-        let outer = rings.swap_remove(outer.expect("a mesh has a boundary"));
+        let Some(outer) = outer.map(|outer| rings.swap_remove(outer)) else {
+            // Every edge has two elements: they overlap (a planar mesh cannot be closed).
+            return Err(MeshgenError::InvalidDomain("the mesh has no boundary edge: its elements overlap".into()));
+        };
         if let Some(ring) = rings.iter().find(|ring| ring_area(ring) > 0.0) {
             return Err(MeshgenError::InvalidDomain(format!(
                 "the mesh has more than one component (a second outer boundary starts at {:?})",
