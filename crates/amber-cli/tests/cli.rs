@@ -200,6 +200,15 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
     }
 }
 
+/// `amber evaluate --model MODEL --data DATA --out OUT`, which must succeed; its evaluation.json.
+fn evaluate(model: &std::path::Path, data: &std::path::Path, out: &std::path::Path) -> serde_json::Value {
+    let output =
+        amber().args(["evaluate", "--model"]).arg(model).arg("--data").arg(data).arg("--out").arg(out).output();
+    let output = output.unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    serde_json::from_str(&std::fs::read_to_string(out.join("evaluation.json")).unwrap()).unwrap()
+}
+
 /// A folder dataset end to end: the project's demo plates (2D `.msh` experts, no geometry files)
 /// train a tiny model, which is evaluated on the test split (JSON, Markdown, a picture per part)
 /// and meshes one of its plates from the plate's boundary alone.
@@ -232,18 +241,7 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     assert!(card["initial_size"].as_f64().unwrap() > 0.05, "{card}");
 
     let out = dir.path().join("evaluation");
-    let output = amber()
-        .args(["evaluate", "--model"])
-        .arg(&run)
-        .arg("--data")
-        .arg(data.join("test"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    let evaluation: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("evaluation.json")).unwrap()).unwrap();
+    let evaluation = evaluate(&run, &data.join("test"), &out);
     let parts = evaluation["parts"].as_array().unwrap();
     assert_eq!(parts.len(), 2);
     for part in parts {
@@ -273,19 +271,7 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
         .output()
         .unwrap();
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    let out = dir.path().join("evaluation-calibrated");
-    let output = amber()
-        .args(["evaluate", "--model"])
-        .arg(&calibrated)
-        .arg("--data")
-        .arg(data.join("test"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    let evaluation: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("evaluation.json")).unwrap()).unwrap();
+    let evaluation = evaluate(&calibrated, &data.join("test"), &dir.path().join("evaluation-calibrated"));
     let log_ratios: Vec<f64> = evaluation["parts"]
         .as_array()
         .unwrap()

@@ -151,8 +151,7 @@ pub fn read_mesh<const D: usize>(path: impl AsRef<Path>) -> Result<Mesh<D>, Mesh
 /// Reads a mesh with the fields and facet tags stored with it, and what was dropped.
 pub fn read_mesh_with_data<const D: usize>(path: impl AsRef<Path>) -> Result<(Mesh<D>, MeshData), MeshError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
-    match parse_raw(path, bytes)? {
+    match parse_raw(path, read_mesh_file(path)?)? {
         Parsed::Json(bytes) => json::read(path, &bytes),
         Parsed::Raw(raw) => raw.finish(path),
     }
@@ -169,8 +168,7 @@ pub enum AnyMesh {
 /// elements decides (3: tetrahedra, 2: triangles). The file is parsed once.
 pub fn read_any_mesh(path: impl AsRef<Path>) -> Result<AnyMesh, MeshError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })?;
-    parse_any_mesh(path, bytes)
+    parse_any_mesh(path, read_mesh_file(path)?)
 }
 
 /// [`read_any_mesh`] of a file's contents: `path` chooses the format by its extension and names
@@ -195,6 +193,14 @@ pub fn parse_any_mesh(path: &Path, bytes: Vec<u8>) -> Result<AnyMesh, MeshError>
 enum Parsed {
     Json(Vec<u8>),
     Raw(raw::RawMesh),
+}
+
+/// The bytes of a mesh file, once its extension names a format amber reads.
+fn read_mesh_file(path: &Path) -> Result<Vec<u8>, MeshError> {
+    if format_of(path).is_none() {
+        return Err(MeshError::UnsupportedFormat { path: path.to_owned(), expected: MESH_FORMATS });
+    }
+    std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_owned(), source })
 }
 
 fn parse_raw(path: &Path, bytes: Vec<u8>) -> Result<Parsed, MeshError> {
