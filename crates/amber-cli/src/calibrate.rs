@@ -5,39 +5,30 @@
 
 use std::path::{Path, PathBuf};
 
-use amber_experiments::{ModelCard, Task, resolve_model};
+use amber_experiments::{ModelCard, Task};
 use amber_tasks::folder::{DatasetSettings, FolderDomain, Split, problems, read_experts};
 use amber_tasks::part::{PlanarPart, SolidPart};
 use amber_train::TrainedModel;
 use anyhow::{Context, bail};
 use clap::Args;
 
-use crate::mesh::shipped_models;
+use crate::evaluate::{LoadedModel, ModelArgs};
 
 #[derive(Args)]
 pub struct CalibrateArgs {
-    /// A trained model: a model or run directory, or a shipped model's name.
-    #[arg(long)]
-    model: String,
+    /// The model, and the steps the scale is fitted for.
+    #[command(flatten)]
+    model: ModelArgs,
     /// A directory of expert meshes, or a dataset folder whose `train/` is taken.
     #[arg(long)]
     data: PathBuf,
-    /// Generation steps the scale is fitted for (default: the model's own number).
-    #[arg(long)]
-    steps: Option<usize>,
     /// The new model directory (the model's files with the fitted predictor).
     #[arg(long, short)]
     out: PathBuf,
 }
 
 pub fn run(args: CalibrateArgs) -> anyhow::Result<()> {
-    let dir = resolve_model(&args.model, &shipped_models())?;
-    let card = ModelCard::read(&dir)?;
-    let mut model = TrainedModel::load(&dir).with_context(|| format!("{}: cannot load the model", dir.display()))?;
-    let steps = args.steps.unwrap_or(card.inference_steps);
-    if steps == 0 {
-        bail!("--steps must be at least 1");
-    }
+    let LoadedModel { dir, card, mut model, steps } = args.model.load()?;
     let train = Split::Train.dir(&args.data);
     let split = if train.is_dir() { train } else { args.data.clone() };
     let settings = DatasetSettings::read(split.parent().unwrap_or(Path::new(".")))?;

@@ -17,33 +17,55 @@ use clap::Args;
 
 use crate::mesh::{Picture, shipped_models};
 
+/// A trained model to roll out on a folder of expert meshes, and for how many steps.
 #[derive(Args)]
-pub struct EvaluateArgs {
+pub struct ModelArgs {
     /// A trained model: a model or run directory, or a shipped model's name.
     #[arg(long)]
-    model: String,
+    pub model: String,
+    /// Generation steps (default: the model's own number).
+    #[arg(long)]
+    pub steps: Option<usize>,
+}
+
+/// A loaded model with its directory, card and number of steps.
+pub struct LoadedModel {
+    pub dir: PathBuf,
+    pub card: ModelCard,
+    pub model: TrainedModel,
+    pub steps: usize,
+}
+
+impl ModelArgs {
+    pub fn load(&self) -> anyhow::Result<LoadedModel> {
+        let dir = resolve_model(&self.model, &shipped_models())?;
+        let card = ModelCard::read(&dir)?;
+        let model = TrainedModel::load(&dir).with_context(|| format!("{}: cannot load the model", dir.display()))?;
+        let steps = self.steps.unwrap_or(card.inference_steps);
+        if steps == 0 {
+            bail!("--steps must be at least 1");
+        }
+        Ok(LoadedModel { dir, card, model, steps })
+    }
+}
+
+#[derive(Args)]
+pub struct EvaluateArgs {
+    #[command(flatten)]
+    model: ModelArgs,
     /// A directory of expert meshes (e.g. `DIR/test`; geometry files beside them or in
     /// `DIR/reference_surface/test/`), or a dataset folder, whose `test/` (else `val/`) is taken.
     #[arg(long)]
     data: PathBuf,
-    /// Generation steps (default: the model's own number).
-    #[arg(long)]
-    steps: Option<usize>,
     /// Where `evaluation.json`, `evaluation.md` and the pictures go.
     #[arg(long, default_value = "evaluation")]
     out: PathBuf,
 }
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
-    let dir = resolve_model(&args.model, &shipped_models())?;
-    let card = ModelCard::read(&dir)?;
-    let mut model = TrainedModel::load(&dir).with_context(|| format!("{}: cannot load the model", dir.display()))?;
+    let LoadedModel { dir, card, mut model, steps } = args.model.load()?;
     // As `amber mesh` does: a field over the budget is scaled to it, not skipped.
     model.limits_mut().scale_to_budget = true;
-    let steps = args.steps.unwrap_or(card.inference_steps);
-    if steps == 0 {
-        bail!("--steps must be at least 1");
-    }
     let split = if Split::Train.dir(&args.data).is_dir() {
         let test = Split::Test.dir(&args.data);
         if test.is_dir() { test } else { Split::Val.dir(&args.data) }
@@ -113,7 +135,7 @@ impl Run<'_> {
             pictures.push(picture);
         }
         let json = serde_json::json!({
-            "model": self.args.model,
+            "model": self.args.model.model,
             "card": self.card,
             "data": self.split,
             "steps": self.steps,
@@ -140,7 +162,7 @@ impl Run<'_> {
         let mut md = format!(
             "# Evaluation of {} on {}\n\n{} ({}), {} generation steps; normalised DCD: 0 as good as the expert's \
              own field re-meshed, 1 no better than M⁰.\n\n",
-            self.args.model,
+            self.args.model.model,
             self.split.display(),
             self.card.method,
             self.card.data,
