@@ -28,9 +28,11 @@ pub struct CalibrateArgs {
 }
 
 pub fn run(args: CalibrateArgs) -> anyhow::Result<()> {
-    let LoadedModel { dir, card, mut model, steps } = args.model.load()?;
     let train = Split::Train.dir(&args.data);
     let split = if train.is_dir() { train } else { args.data.clone() };
+    let loaded = args.model.load()?;
+    loaded.check_dimension(&split)?;
+    let LoadedModel { dir, card, mut model, steps } = loaded;
     let settings = DatasetSettings::read(split.parent().unwrap_or(Path::new(".")))?;
     let before = model.limits().final_step_scale;
     let scale = match card.task {

@@ -9,7 +9,7 @@ use amber_experiments::{ModelCard, ProblemEvaluation, Task, resolve_model, write
 use amber_mesh::Mesh;
 use amber_plot::{Tile, mesh_gallery};
 use amber_tasks::Problem;
-use amber_tasks::folder::{DatasetSettings, FolderDomain, Split, problems, read_experts};
+use amber_tasks::folder::{DatasetSettings, FolderDomain, Split, mesh_dimension, problems, read_experts};
 use amber_tasks::part::{PlanarPart, SolidPart};
 use amber_train::{Evaluation, EvaluationSummary, TrainedModel};
 use anyhow::{Context, bail};
@@ -49,6 +49,27 @@ impl ModelArgs {
     }
 }
 
+impl LoadedModel {
+    /// Fails, naming both, when the meshes of `split` are not of the dimension the model meshes.
+    pub fn check_dimension(&self, split: &Path) -> anyhow::Result<()> {
+        let model = match self.card.task {
+            Task::Console => 3,
+            Task::Folder { dimension } => dimension,
+            // Poisson models read problems, not meshes: the callers say so.
+            Task::Poisson => return Ok(()),
+        };
+        let found = mesh_dimension(split)?;
+        if found != model {
+            bail!(
+                "{}: holds {found}D meshes, but the model {} meshes in {model}D",
+                split.display(),
+                self.dir.display()
+            );
+        }
+        Ok(())
+    }
+}
+
 #[derive(Args)]
 pub struct EvaluateArgs {
     #[command(flatten)]
@@ -63,15 +84,17 @@ pub struct EvaluateArgs {
 }
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
-    let LoadedModel { dir, card, mut model, steps } = args.model.load()?;
-    // As `amber mesh` does: a field over the budget is scaled to it, not skipped.
-    model.limits_mut().scale_to_budget = true;
     let split = if Split::Train.dir(&args.data).is_dir() {
         let test = Split::Test.dir(&args.data);
         if test.is_dir() { test } else { Split::Val.dir(&args.data) }
     } else {
         args.data.clone()
     };
+    let loaded = args.model.load()?;
+    loaded.check_dimension(&split)?;
+    let LoadedModel { dir, card, mut model, steps } = loaded;
+    // As `amber mesh` does: a field over the budget is scaled to it, not skipped.
+    model.limits_mut().scale_to_budget = true;
     let settings = DatasetSettings::read(split.parent().unwrap_or(Path::new(".")))?;
     let evaluation = Run { args: &args, card: &card, model: &model, split: &split, settings: &settings, steps };
     match card.task {

@@ -292,6 +292,16 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     let generated = amber_mesh::read_mesh::<2>(&mesh).unwrap();
     assert!((generated.total_volume() - expert.total_volume()).abs() < 1e-9);
 
+    // A 2D model on a folder of tet meshes is an error naming both.
+    let solids = dir.path().join("solids");
+    std::fs::create_dir_all(&solids).unwrap();
+    let tet =
+        amber_mesh::Mesh3::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3]);
+    amber_mesh::write_mesh(&tet.unwrap(), solids.join("tet.vtu"), &amber_mesh::MeshData::new()).unwrap();
+    let output = amber().args(["evaluate", "--model"]).arg(&run).arg("--data").arg(&solids).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("holds 3D meshes") && stderr.contains("in 2D"), "{stderr}");
+
     // A folder with a split missing is an error naming it, not a panic.
     std::fs::remove_dir_all(data.join("val")).unwrap();
     let output = amber()
