@@ -3,6 +3,8 @@
 use std::collections::{HashMap, HashSet};
 
 use amber_mesh::{FacetAdjacency, Mesh2};
+use rstar::primitives::{GeomWithData, Line};
+use rstar::{PointDistance, RTree};
 use serde::{Deserialize, Serialize};
 
 use crate::MeshgenError;
@@ -231,6 +233,55 @@ impl PolygonDomain {
 }
 
 /// Signed area of a closed ring (positive when counter-clockwise).
+/// R-trees over a polygon domain's edges and corners, for exact nearest-distance queries: the
+/// 2D counterpart of [`crate::mesh3d::SurfaceDistance`].
+#[derive(Clone, Debug)]
+pub struct PolygonDistance {
+    edges: RTree<Line<[f64; 2]>>,
+    /// The vertices where the boundary turns by more than [`CORNER_TURN`], each with its turn
+    /// (positive where the domain is convex, negative at a re-entrant corner).
+    corners: RTree<GeomWithData<[f64; 2], f64>>,
+}
+
+/// The smallest turn of the boundary that makes a vertex a corner: a polygon that approximates
+/// a circle with 12 or more vertices has no corners.
+const CORNER_TURN: f64 = std::f64::consts::PI / 6.0;
+
+impl PolygonDistance {
+    /// Indexes the rings of `domain`.
+    pub fn new(domain: &PolygonDomain) -> Self {
+        let outer_sign = ring_area(domain.outer()).signum();
+        let mut edges = Vec::new();
+        let mut corners = Vec::new();
+        for (r, ring) in domain.rings().enumerate() {
+            // Walking with the domain on the left: the outer ring anticlockwise, holes clockwise.
+            let sign = if r == 0 { outer_sign } else { -ring_area(ring).signum() };
+            let n = ring.len();
+            for (i, &v) in ring.iter().enumerate() {
+                let (prev, next) = (ring[(i + n - 1) % n], ring[(i + 1) % n]);
+                edges.push(Line::new(v, next));
+                let (a, b) = ([v[0] - prev[0], v[1] - prev[1]], [next[0] - v[0], next[1] - v[1]]);
+                let turn = sign * (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
+                if turn.abs() > CORNER_TURN {
+                    corners.push(GeomWithData::new(v, turn));
+                }
+            }
+        }
+        Self { edges: RTree::bulk_load(edges), corners: RTree::bulk_load(corners) }
+    }
+
+    /// The distance from `p` to the boundary.
+    pub fn to_boundary(&self, p: [f64; 2]) -> f64 {
+        self.edges.nearest_neighbor(p).map_or(f64::INFINITY, |e| e.distance_2(&p).sqrt())
+    }
+
+    /// The distance from `p` to the nearest corner and how far the boundary turns there (in
+    /// radians, negative at a re-entrant corner), or `None` for a domain without corners.
+    pub fn to_corner(&self, p: [f64; 2]) -> Option<(f64, f64)> {
+        self.corners.nearest_neighbor(p).map(|c| (c.distance_2(&p).sqrt(), c.data))
+    }
+}
+
 fn ring_area(ring: &[[f64; 2]]) -> f64 {
     0.5 * (0..ring.len())
         .map(|i| {
@@ -359,5 +410,23 @@ mod tests {
         assert!((d.area() - 0.5).abs() < 1e-15);
         let bowtie = r#"{"outer": [[0,0],[1,1],[1,0],[0,1]]}"#;
         assert!(serde_json::from_str::<PolygonDomain>(bowtie).unwrap_err().to_string().contains("self-intersecting"));
+    }
+
+    /// The L-shape turns a quarter left at its five convex corners and a quarter right at the
+    /// re-entrant one, whichever way its rings run.
+    #[test]
+    fn distances_in_the_l_shape() {
+        let lshape = PolygonDomain::lshape([0.5, 0.5]).unwrap();
+        let reversed = PolygonDomain::new(lshape.outer().iter().rev().copied().collect(), vec![]).unwrap();
+        for domain in [lshape, reversed] {
+            let distance = PolygonDistance::new(&domain);
+            let p = [0.45, 0.6];
+            assert!((distance.to_boundary(p) - 0.05).abs() < 1e-12);
+            let (to_corner, turn) = distance.to_corner(p).unwrap();
+            assert!((to_corner - 0.0125f64.sqrt()).abs() < 1e-12);
+            assert!((turn + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+            let (_, turn) = distance.to_corner([0.1, 0.1]).unwrap();
+            assert!((turn - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        }
     }
 }

@@ -10,7 +10,7 @@ mod mesh2d;
 mod quality;
 mod sizing;
 
-pub use domain::PolygonDomain;
+pub use domain::{PolygonDistance, PolygonDomain};
 pub use error::MeshgenError;
 pub use mesh2d::{Mesh2dParams, generate_2d, uniform_mesh_2d};
 pub use quality::QualityReport;

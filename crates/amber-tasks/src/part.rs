@@ -8,10 +8,11 @@ use std::path::Path;
 
 use amber_graph::FeatureSet;
 use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, StlFaceIds, read_any_mesh, read_surface};
-use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, Surface, generate_3d};
+use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, Surface, SurfaceDistance, generate_3d};
 use amber_meshgen::{
-    ConstantSize, Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, generate_2d, uniform_mesh_2d,
+    ConstantSize, Mesh2dParams, MeshSizing, MeshgenError, PolygonDistance, PolygonDomain, generate_2d, uniform_mesh_2d,
 };
+use rayon::prelude::*;
 
 use crate::TaskError;
 use crate::problem::{Column, Domain, ProblemError};
@@ -87,6 +88,42 @@ pub(crate) fn polygon_domain_of_mesh(path: &Path, mesh: &Mesh2) -> Result<Polygo
         .map_err(|e| TaskError::Geometry { path: path.into(), message: format!("boundary of the mesh: {e}") })
 }
 
+/// The optional node inputs a geometry-only domain offers (see [`Domain::optional_inputs`]):
+/// the log distance from each element's midpoint to the boundary and to the nearest feature (a
+/// curve where two CAD faces meet in 3D, a corner in 2D), and how far the boundary turns at that
+/// feature (radians). They come from the geometry alone, so every dataset has them.
+pub const GEOMETRY_INPUTS: [&str; 3] = ["log_boundary_distance", "log_feature_distance", "feature_turn"];
+
+/// The columns of [`GEOMETRY_INPUTS`] for elements with midpoints `midpoints`, given the distance
+/// to the boundary and to the nearest feature (with its turn) of a point. Distances are floored
+/// at 10⁻⁶ of the geometry's extent `extent` before the logarithm; without features, the
+/// feature lies at `extent` and turns by 0.
+fn geometry_columns<const D: usize>(
+    midpoints: &[[f64; D]],
+    extent: f64,
+    to_boundary: impl Fn([f64; D]) -> f64 + Sync,
+    to_feature: impl Fn([f64; D]) -> Option<(f64, f64)> + Sync,
+) -> Vec<Column> {
+    let floor = 1e-6 * extent;
+    let rows: Vec<[f64; 3]> = midpoints
+        .par_iter()
+        .map(|&p| {
+            let (to_feature, turn) = to_feature(p).unwrap_or((extent, 0.0));
+            [to_boundary(p).max(floor).ln(), to_feature.max(floor).ln(), turn]
+        })
+        .collect();
+    GEOMETRY_INPUTS
+        .iter()
+        .enumerate()
+        .map(|(i, name)| Column { name: (*name).into(), values: rows.iter().map(|row| row[i]).collect() })
+        .collect()
+}
+
+/// The length of the diagonal of a bounding box.
+fn diagonal<const D: usize>((min, max): ([f64; D], [f64; D])) -> f64 {
+    min.iter().zip(&max).map(|(a, b)| (b - a) * (b - a)).sum::<f64>().sqrt()
+}
+
 /// A solid to mesh: its bounding surface and M⁰.
 #[derive(Clone, Debug)]
 pub struct SolidPart {
@@ -96,6 +133,7 @@ pub struct SolidPart {
     pub surface: Surface,
     /// M⁰: a uniform mesh of the solid.
     pub initial_mesh: Mesh3,
+    distance: SurfaceDistance,
 }
 
 impl SolidPart {
@@ -104,7 +142,8 @@ impl SolidPart {
     pub fn new(name: String, surface: Surface, initial_size: f64) -> Result<Self, Mesh3dError> {
         let params = Mesh3dParams { curvature_tolerance: f64::INFINITY, size_factor: 1.0, ..Mesh3dParams::default() };
         let initial_mesh = generate_3d(&surface, &ConstantSize(initial_size), &params)?;
-        Ok(Self { name, surface, initial_mesh })
+        let distance = SurfaceDistance::new(&surface);
+        Ok(Self { name, surface, initial_mesh, distance })
     }
 }
 
@@ -114,13 +153,19 @@ impl Domain<3> for SolidPart {
         FeatureSet::console()
     }
 
+    fn optional_inputs(&self) -> &'static [&'static str] {
+        &GEOMETRY_INPUTS
+    }
+
     fn initial_mesh(&self) -> &Mesh<3> {
         &self.initial_mesh
     }
 
-    /// None: the features are geometric, computed by the graph.
-    fn columns(&self, _mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
-        Ok(Vec::new())
+    /// The [`GEOMETRY_INPUTS`]; the feature set's own features are computed by the graph.
+    fn columns(&self, mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
+        let extent = amber_mesh::bounding_box(self.surface.vertices()).map_or(1.0, diagonal);
+        let distance = &self.distance;
+        Ok(geometry_columns(&mesh.midpoints(), extent, |p| distance.to_surface(p), |p| distance.to_feature_curve(p)))
     }
 
     fn remesh(&self, mesh: &Mesh<3>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<3>, ProblemError> {
@@ -139,13 +184,15 @@ pub struct PlanarPart {
     pub domain: PolygonDomain,
     /// M⁰: a uniform mesh of the domain.
     pub initial_mesh: Mesh2,
+    distance: PolygonDistance,
 }
 
 impl PlanarPart {
     /// Meshes M⁰ uniformly with size `initial_size`.
     pub fn new(name: String, domain: PolygonDomain, initial_size: f64) -> Result<Self, MeshgenError> {
         let initial_mesh = uniform_mesh_2d(&domain, initial_size, &Mesh2dParams::default())?;
-        Ok(Self { name, domain, initial_mesh })
+        let distance = PolygonDistance::new(&domain);
+        Ok(Self { name, domain, initial_mesh, distance })
     }
 }
 
@@ -155,17 +202,53 @@ impl Domain<2> for PlanarPart {
         FeatureSet::console()
     }
 
+    fn optional_inputs(&self) -> &'static [&'static str] {
+        &GEOMETRY_INPUTS
+    }
+
     fn initial_mesh(&self) -> &Mesh<2> {
         &self.initial_mesh
     }
 
-    /// None: the features are geometric, computed by the graph.
-    fn columns(&self, _mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-        Ok(Vec::new())
+    /// The [`GEOMETRY_INPUTS`]; the feature set's own features are computed by the graph.
+    fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
+        let extent = diagonal(self.domain.bounding_box());
+        let distance = &self.distance;
+        Ok(geometry_columns(&mesh.midpoints(), extent, |p| distance.to_boundary(p), |p| distance.to_corner(p)))
     }
 
     fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
         let params = Mesh2dParams::default().with_max_elements(max_elements);
         Ok(generate_2d(&self.domain, &MeshSizing::new(mesh, sizes), &params)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::FRAC_PI_2;
+
+    use super::*;
+
+    /// Every element of an L-shaped plate gets the geometry inputs, no element is farther from
+    /// the boundary than from the nearest corner, and the element nearest to the re-entrant
+    /// corner sees the boundary turn a quarter right there.
+    #[test]
+    fn an_l_shaped_plate_has_its_geometry_inputs() {
+        let part = PlanarPart::new("l".into(), PolygonDomain::lshape([0.5, 0.5]).unwrap(), 0.05).unwrap();
+        let columns = part.columns(&part.initial_mesh).unwrap();
+        let names: Vec<&str> = columns.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, GEOMETRY_INPUTS);
+        let [boundary, feature, turn] = [0, 1, 2].map(|i| &columns[i].values);
+        assert!(boundary.iter().all(|v| v.is_finite()) && boundary.len() == part.initial_mesh.num_elements());
+        assert!(boundary.iter().zip(feature).all(|(b, f)| b <= f));
+        let distance_to_reentrant = |e: usize| {
+            let [x, y] = part.initial_mesh.midpoint(e);
+            (x - 0.5).hypot(y - 0.5)
+        };
+        let nearest =
+            (0..boundary.len()).min_by(|&a, &b| distance_to_reentrant(a).total_cmp(&distance_to_reentrant(b)));
+        let nearest = nearest.unwrap();
+        assert!((turn[nearest] + FRAC_PI_2).abs() < 1e-12);
+        assert!((feature[nearest] - distance_to_reentrant(nearest).ln()).abs() < 1e-12);
     }
 }

@@ -6,6 +6,7 @@
 //! field; [`generate_3d`] runs both, capped by curvature and by an element budget. Exact
 //! predicates and triangle intersection tests are private helpers.
 
+mod distance;
 mod generate;
 mod intersect;
 mod predicates;
@@ -13,6 +14,7 @@ pub mod remesh;
 pub mod surface;
 pub mod tetgen;
 
+pub use distance::SurfaceDistance;
 pub use generate::{Mesh3dError, Mesh3dParams, adapt_surface, fill_surface, generate_3d};
 pub use remesh::{RemeshError, RemeshParams, remesh};
 pub use surface::{StlFaceIds, Surface, SurfaceDefect, SurfaceError, SurfaceReport};
@@ -49,4 +51,13 @@ fn unit_cube_triangles() -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<i32>) {
         ids.extend([side as i32 + 1; 2]);
     }
     (v, triangles, ids)
+}
+
+/// The unit cube as a validated surface, one CAD face per side.
+#[cfg(test)]
+fn unit_cube() -> Surface {
+    let (v, triangles, ids) = unit_cube_triangles();
+    let mut s = Surface::new(v, triangles, ids).expect("the unit cube is a surface");
+    s.validate().expect("the unit cube bounds a solid");
+    s
 }

@@ -19,8 +19,9 @@ use std::collections::{BTreeMap, HashMap};
 
 use nalgebra::Vector3;
 use rstar::primitives::Line;
-use rstar::{AABB, Envelope, PointDistance, RTree, RTreeObject};
+use rstar::{AABB, Envelope, RTree};
 
+use super::distance::RefTriangle;
 use super::intersect::{TriangleIndex, triangle_box, triangles_intersect, triangles_overlap};
 use super::surface::{Surface, SurfaceDefect};
 use crate::SizingField;
@@ -210,60 +211,6 @@ fn plane_of(triangles: &[RefTriangle]) -> Option<(Vector3<f64>, Vector3<f64>)> {
     let n = n / length;
     let extent = corners().map(|c| (c - origin).norm()).fold(0.0, f64::max);
     corners().all(|c| (c - origin).dot(&n).abs() <= 1e-5 * extent).then_some((origin, n))
-}
-
-/// A reference triangle in an R-tree that answers distance queries exactly.
-struct RefTriangle([[f64; 3]; 3]);
-
-impl RefTriangle {
-    /// Closest point of the triangle to `p` (Ericson, Real-Time Collision Detection §5.1.5).
-    fn closest(&self, p: [f64; 3]) -> [f64; 3] {
-        let [a, b, c] = self.0.map(Vector3::from);
-        let p = Vector3::from(p);
-        let (ab, ac, ap) = (b - a, c - a, p - a);
-        let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
-        if d1 <= 0.0 && d2 <= 0.0 {
-            return a.into();
-        }
-        let bp = p - b;
-        let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
-        if d3 >= 0.0 && d4 <= d3 {
-            return b.into();
-        }
-        let vc = d1 * d4 - d3 * d2;
-        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-            return (a + ab * (d1 / (d1 - d3))).into();
-        }
-        let cp = p - c;
-        let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
-        if d6 >= 0.0 && d5 <= d6 {
-            return c.into();
-        }
-        let vb = d5 * d2 - d1 * d6;
-        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-            return (a + ac * (d2 / (d2 - d6))).into();
-        }
-        let va = d3 * d6 - d5 * d4;
-        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-            return (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))).into();
-        }
-        let denom = 1.0 / (va + vb + vc);
-        (a + ab * (vb * denom) + ac * (vc * denom)).into()
-    }
-}
-
-impl RTreeObject for RefTriangle {
-    type Envelope = AABB<[f64; 3]>;
-
-    fn envelope(&self) -> Self::Envelope {
-        AABB::from_points(self.0.iter())
-    }
-}
-
-impl PointDistance for RefTriangle {
-    fn distance_2(&self, p: &[f64; 3]) -> f64 {
-        (Vector3::from(self.closest(*p)) - Vector3::from(*p)).norm_squared()
-    }
 }
 
 /// The surface being remeshed: triangles with their CAD faces, vertex → triangle lists and the
@@ -797,13 +744,7 @@ mod tests {
     use super::*;
     use crate::{ConstantSize, FnSize};
 
-    /// The unit cube as 12 triangles, one CAD face per side.
-    fn cube() -> Surface {
-        let (v, triangles, ids) = super::super::unit_cube_triangles();
-        let mut s = Surface::new(v, triangles, ids).unwrap();
-        s.validate().unwrap();
-        s
-    }
+    use crate::mesh3d::unit_cube as cube;
 
     /// Median and 5th/95th percentile of edge length / size at the edge midpoint.
     fn edge_ratios(s: &Surface, h: impl Fn([f64; 3]) -> f64) -> (f64, f64, f64) {
@@ -867,17 +808,6 @@ mod tests {
             remesh(&cube(), &ConstantSize(1e-3), &params),
             Err(RemeshError::TooManyTriangles { cap: 1000 })
         ));
-    }
-
-    #[test]
-    fn closest_point_on_a_triangle() {
-        let t = RefTriangle([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
-        assert_eq!(t.closest([0.5, 0.5, 3.0]), [0.5, 0.5, 0.0]);
-        assert_eq!(t.closest([-1.0, -1.0, 1.0]), [0.0, 0.0, 0.0]);
-        assert_eq!(t.closest([3.0, -1.0, 0.0]), [2.0, 0.0, 0.0]);
-        assert_eq!(t.closest([1.0, -5.0, 0.0]), [1.0, 0.0, 0.0]);
-        assert_eq!(t.closest([2.0, 2.0, 0.0]), [1.0, 1.0, 0.0]);
-        assert_eq!(t.distance_2(&[0.5, 0.5, 3.0]), 9.0);
     }
 
     /// Console reference surfaces remeshed to 2 mm and 4 mm, then filled by TetGen with the
