@@ -24,46 +24,63 @@ pub enum Task {
     Folder { dimension: usize },
 }
 
+impl Task {
+    /// The dimension of the task's meshes.
+    pub fn dimension(self) -> usize {
+        match self {
+            Task::Poisson => 2,
+            Task::Console => 3,
+            Task::Folder { dimension } => dimension,
+        }
+    }
+}
+
 /// AMBER's configuration of `task` under `profile` (before the method's labels and the seed).
+/// Console is one folder dataset of 3D parts meshed by human experts: it and every 3D folder get
+/// the same values, so `amber train --data` on the Console folder trains what `reproduce console`
+/// does.
 pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
     let mut config = TrainingConfig::profile(profile);
-    match (task, profile) {
-        (Task::Poisson, Profile::Paper) => {}
+    match task {
         // ln η_K: 0.324 → 0.118 on Poisson hard at quick scale; not one of the paper's inputs.
-        (Task::Poisson, Profile::Smoke | Profile::Quick) => config.inputs.push(LOG_ERROR_INDICATOR_COLUMN.into()),
-        (Task::Console, _) => {
-            // Spec §9: latent width 128, h_min at the 0.5 % quantile of the training experts' sizes.
-            config.min_size_quantile = 0.005;
-
-            config.calibrate_element_count = true;
-            if profile != Profile::Smoke {
-                config.network.latent_dim = 128;
-            }
-            if profile == Profile::Quick {
-                // A batch is at least one whole part (1.4k–42k elements): fewer, slower steps.
-                config.steps = 1_200;
-                config.validation_interval = 400;
+        Task::Poisson => {
+            if profile != Profile::Paper {
+                config.inputs.push(LOG_ERROR_INDICATOR_COLUMN.into());
             }
         }
-        // Geometry is all a folder offers; log h(K) is the generic input every profile but the
-        // paper's already reads.
-        (Task::Folder { .. }, _) => {
+        Task::Console | Task::Folder { .. } => {
+            // Spec §9: h_min at the 0.5 % quantile of the training experts' sizes.
+            config.min_size_quantile = 0.005;
             config.calibrate_element_count = true;
-            if !config.inputs.iter().any(|i| i == LOG_SIZE_COLUMN) {
+            // Geometry is all a folder offers; log h(K) is the generic input every profile but
+            // the paper's already reads (the paper's Console network goes without it).
+            if task != Task::Console && !config.inputs.iter().any(|i| i == LOG_SIZE_COLUMN) {
                 config.inputs.push(LOG_SIZE_COLUMN.into());
+            }
+            if task.dimension() == 3 {
+                // Spec §9: latent width 128.
+                if profile != Profile::Smoke {
+                    config.network.latent_dim = 128;
+                }
+                if profile == Profile::Quick {
+                    // A batch is at least one whole part (1.4k–42k elements): fewer, slower steps.
+                    config.steps = 1_200;
+                    config.validation_interval = 400;
+                }
             }
         }
     }
     config
 }
 
-/// The U-Net's configuration of `task` under `profile` on a `resolution`ᴰ grid.
+/// The U-Net's configuration of `task` under `profile` on a `resolution`ᴰ grid (Console and 3D
+/// folders alike, as for AMBER).
 pub fn cnn_config(task: Task, profile: Profile, resolution: usize) -> CnnConfig {
     let mut config = CnnConfig::profile(profile);
     config.resolution = resolution;
-    if task == Task::Console {
+    if task != Task::Poisson {
         config.min_size_quantile = 0.005;
-        if profile == Profile::Quick {
+        if task.dimension() == 3 && profile == Profile::Quick {
             // 9 and 14 minutes of training for 32³ and 64³ on two cores.
             (config.steps, config.images_per_step) = if resolution <= 32 { (300, Some(4)) } else { (100, Some(3)) };
         }
@@ -111,7 +128,7 @@ mod tests {
 
     #[test]
     fn every_task_and_profile_gives_a_valid_config() {
-        for task in [Task::Poisson, Task::Console, Task::Folder { dimension: 2 }] {
+        for task in [Task::Poisson, Task::Console, Task::Folder { dimension: 2 }, Task::Folder { dimension: 3 }] {
             for profile in Profile::ALL {
                 amber_config(task, profile).validate().unwrap();
                 cnn_config(task, profile, 32).validate().unwrap();
@@ -123,6 +140,11 @@ mod tests {
         for profile in Profile::ALL {
             let inputs = amber_config(Task::Folder { dimension: 3 }, profile).inputs;
             assert_eq!(inputs, [LOG_SIZE_COLUMN], "{profile:?}");
+            let (mut console, mut folder) =
+                (amber_config(Task::Console, profile), amber_config(Task::Folder { dimension: 3 }, profile));
+            (console.inputs, folder.inputs) = (Vec::new(), Vec::new());
+            assert_eq!(console, folder, "{profile:?}");
+            assert_eq!(cnn_config(Task::Console, profile, 32), cnn_config(Task::Folder { dimension: 3 }, profile, 32));
         }
     }
 }
