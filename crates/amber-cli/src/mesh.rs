@@ -9,10 +9,12 @@ use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, MeshData, read_any_mesh, read_mesh
 use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
 use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
-use amber_tasks::part::{FEATURE_ANGLE_DEGREES, PlanarPart, SolidPart, read_polygon_domain, read_solid_surface};
+use amber_tasks::part::{
+    FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, read_polygon_domain, read_solid_surface,
+};
 use amber_tasks::poisson::{PoissonPart, read_part, read_problem};
 use amber_tasks::{Domain, WithExpert};
-use amber_train::{ElementTarget, GeneratedStep, MeshMetrics, Reference, TrainedModel};
+use amber_train::{ElementTarget, GeneratedStep, MeshMetrics, Reference, TrainError, TrainedModel};
 use anyhow::{Context, bail};
 use clap::Args;
 
@@ -44,7 +46,8 @@ pub struct MeshArgs {
     elements: Option<usize>,
     /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,
     /// and its domain when no geometry is given; its expert mesh, when present, is the default
-    /// --expert).
+    /// --expert), or a part's inputs (`<stem>.inputs.json`: named numbers and points) for a model
+    /// trained on a dataset folder whose parts have them.
     #[arg(long)]
     problem: Option<PathBuf>,
     /// The expert's mesh of this geometry: each step is scored against it (normalised DCD, DCD,
@@ -104,15 +107,17 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             let geometry = args.geometry.as_deref().context("give the geometry to mesh: a closed STL or a tet mesh")?;
             let path = Path::new(geometry);
             let surface = read_solid_surface(path, args.feature_angle)?;
-            let part = SolidPart::new(part_name(geometry), surface, card.initial_size)
+            let mut part = SolidPart::new(part_name(geometry), surface, card.initial_size)
                 .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
+            part.inputs = part_inputs(args)?;
             let expert = args.expert.as_deref().map(read_mesh::<3>).transpose()?;
             mesh_domain(args, &trained, part, expert, steps)
         }
         Task::Folder { dimension: 2 } => {
             let geometry = args.geometry.as_deref().unwrap_or("lshape");
-            let part = PlanarPart::new(part_name(geometry), planar_domain(args)?, card.initial_size)
+            let mut part = PlanarPart::new(part_name(geometry), planar_domain(args)?, card.initial_size)
                 .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
+            part.inputs = part_inputs(args)?;
             let expert = args.expert.as_deref().map(read_mesh::<2>).transpose()?;
             mesh_domain(args, &trained, part, expert, steps)
         }
@@ -120,6 +125,11 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             bail!("{}: a model of {dimension}D meshes; amber meshes 2D and 3D", dir.display())
         }
     }
+}
+
+/// The part's own inputs of `--problem` (none without it).
+fn part_inputs<const D: usize>(args: &MeshArgs) -> anyhow::Result<PartInputs<D>> {
+    Ok(args.problem.as_deref().map(PartInputs::read).transpose()?.unwrap_or_default())
 }
 
 /// What reports call a part: the geometry file's stem.
@@ -148,7 +158,10 @@ where
 {
     let start = Instant::now();
     let target = args.elements.map(|elements| ElementTarget { elements, max_elements: args.max_elements });
-    let generated = model.generate(&domain, steps, target)?;
+    let generated = model.generate(&domain, steps, target).map_err(|e| match e {
+        TrainError::MissingInputs(_) => anyhow::anyhow!("{e}: give the part's inputs with --problem FILE.inputs.json"),
+        e => e.into(),
+    })?;
     let seconds = start.elapsed().as_secs_f64();
     let scored = expert.map(|expert_mesh| WithExpert { domain, expert_mesh });
     let reference = scored.as_ref().map(|p| Reference::new(p, model.limits())).transpose()?;

@@ -5,6 +5,7 @@
 //! it is: docs/PROFILES.md.
 
 use amber_tasks::LOG_SIZE_COLUMN;
+use amber_tasks::part::GEOMETRY_INPUTS;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
 use amber_train::{CnnConfig, MethodConfig, Profile, TrainingConfig};
 
@@ -56,6 +57,10 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
             // the paper's already reads (the paper's Console network goes without it).
             if task != Task::Console && !config.inputs.iter().any(|i| i == LOG_SIZE_COLUMN) {
                 config.inputs.push(LOG_SIZE_COLUMN.into());
+            }
+            // Where the geometry is (boundary, feature curves): Console val 0.235 → 0.167.
+            if profile != Profile::Paper {
+                config.inputs.extend(GEOMETRY_INPUTS.map(String::from));
             }
             if task.dimension() == 3 {
                 // Spec §9: latent width 128.
@@ -139,7 +144,9 @@ mod tests {
         assert!(amber_config(Task::Poisson, Profile::Paper).inputs.is_empty());
         for profile in Profile::ALL {
             let inputs = amber_config(Task::Folder { dimension: 3 }, profile).inputs;
-            assert_eq!(inputs, [LOG_SIZE_COLUMN], "{profile:?}");
+            assert_eq!(inputs[0], LOG_SIZE_COLUMN, "{profile:?}");
+            let geometric = inputs[1..].iter().all(|i| GEOMETRY_INPUTS.contains(&i.as_str()));
+            assert!(geometric && inputs.len() == if profile == Profile::Paper { 1 } else { 4 }, "{profile:?}");
             let (mut console, mut folder) =
                 (amber_config(Task::Console, profile), amber_config(Task::Folder { dimension: 3 }, profile));
             (console.inputs, folder.inputs) = (Vec::new(), Vec::new());

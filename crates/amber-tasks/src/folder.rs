@@ -5,13 +5,15 @@
 //! DIR/dataset.json                       optional: settings a folder cannot say (DatasetSettings)
 //! DIR/train/<stem>.<mesh>                one expert mesh per part, any format amber reads
 //! DIR/train/<stem>.stl|.obj|.json        optional geometry beside it (3D surface, 2D polygon)
+//! DIR/train/<stem>.inputs.json           optional inputs of the part (named scalars and points)
 //! DIR/val/…  [DIR/test/…]
 //! DIR/reference_surface/<split>/<stem>.stl|.obj|.json   the geometry, when not beside the mesh
 //! ```
 //!
 //! A file is an expert mesh when `amber_mesh::read_mesh` reads its extension (a `.json` beside a
 //! mesh of the same stem is that mesh's polygon instead); other files (`.step`, notes) are
-//! ignored. The dimension comes from the files (tets: 3D, triangles: 2D). Without a geometry
+//! ignored. A part's inputs ([`PartInputs`]) are node inputs a model may read; every part of a
+//! dataset has the same names or none. The dimension comes from the files (tets: 3D, triangles: 2D). Without a geometry
 //! file, the expert mesh's own boundary is the geometry. A part is a [`FolderDomain`]:
 //! [`SolidPart`] in 3D, [`PlanarPart`] in 2D, with M⁰ a uniform mesh of one size for the whole
 //! dataset.
@@ -26,8 +28,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::TaskError;
 use crate::part::{
-    FEATURE_ANGLE_DEGREES, PlanarPart, SolidPart, polygon_domain_of_mesh, read_polygon_domain, read_solid_surface,
-    solid_surface_of_mesh,
+    FEATURE_ANGLE_DEGREES, PART_INPUTS_SUFFIX, PartInputs, PlanarPart, SolidPart, polygon_domain_of_mesh,
+    read_polygon_domain, read_solid_surface, solid_surface_of_mesh,
 };
 use crate::problem::{Domain, WithExpert};
 
@@ -125,6 +127,15 @@ pub struct Expert<const D: usize> {
     pub mesh: Mesh<D>,
     /// The geometry file (beside the mesh or under [`GEOMETRY_DIR`]); `None`: the mesh's boundary.
     pub geometry: Option<PathBuf>,
+    /// The part's inputs file (`<stem>.inputs.json` beside the mesh or under [`GEOMETRY_DIR`]).
+    pub inputs: Option<PathBuf>,
+}
+
+impl<const D: usize> Expert<D> {
+    /// The part's inputs: its inputs file's, or none without one.
+    fn read_inputs(&self) -> Result<PartInputs<D>, TaskError> {
+        self.inputs.as_deref().map_or_else(|| Ok(PartInputs::default()), PartInputs::read)
+    }
 }
 
 /// Whether `path` is a geometry file of a `D`-dimensional part (surfaces in 3D, polygons in 2D).
@@ -148,6 +159,9 @@ fn part_files(dir: &Path) -> Result<BTreeMap<String, Vec<PathBuf>>, TaskError> {
     let mut by_stem: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
     for entry in std::fs::read_dir(dir).map_err(io)? {
         let path = entry.map_err(io)?.path();
+        if path.to_str().is_some_and(|p| p.ends_with(PART_INPUTS_SUFFIX)) {
+            continue;
+        }
         if let (true, Some(stem)) = (path.is_file(), path.file_stem().and_then(|s| s.to_str())) {
             by_stem.entry(stem.to_owned()).or_default().push(path);
         }
@@ -198,6 +212,18 @@ fn find_geometry(dir: &Path, stem: &str, files: &[PathBuf], mesh: &Path, dimensi
     extensions.iter().map(|e| root.join(GEOMETRY_DIR).join(split).join(format!("{stem}.{e}"))).find(|p| p.is_file())
 }
 
+/// The inputs file of part `stem` of the split `dir`: beside the mesh, else under
+/// `<root>/reference_surface/<split>/`.
+fn find_inputs(dir: &Path, stem: &str) -> Option<PathBuf> {
+    let name = format!("{stem}{PART_INPUTS_SUFFIX}");
+    let beside = dir.join(&name);
+    if beside.is_file() {
+        return Some(beside);
+    }
+    let (root, split) = (dir.parent()?, dir.file_name()?);
+    Some(root.join(GEOMETRY_DIR).join(split).join(name)).filter(|p| p.is_file())
+}
+
 /// The dimension of the meshes in the split directory `dir`: that of its first expert mesh (the
 /// others must match when read).
 pub fn mesh_dimension(dir: &Path) -> Result<usize, TaskError> {
@@ -244,7 +270,8 @@ pub fn read_experts<const D: usize>(dir: &Path, limit: Option<usize>) -> Result<
             .map(|(stem, files)| {
                 Ok(read_part_mesh::<D>(files)?.map(|(path, mesh)| {
                     let geometry = find_geometry(dir, stem, files, &path, D);
-                    Expert { name: format!("{split}/{stem}"), path, mesh, geometry }
+                    let inputs = find_inputs(dir, stem);
+                    Expert { name: format!("{split}/{stem}"), path, mesh, geometry, inputs }
                 }))
             })
             .collect::<Result<_, TaskError>>()?;
@@ -319,7 +346,10 @@ impl FolderDomain<3> for SolidPart {
         };
         let bounds = amber_mesh::bounding_box(surface.vertices()).expect("a validated surface has vertices");
         check_geometry(expert, bounds, surface.enclosed_volume())?;
-        SolidPart::new(expert.name.clone(), surface, initial_size).map_err(|e| initial_mesh_error(expert, e))
+        let mut part =
+            SolidPart::new(expert.name.clone(), surface, initial_size).map_err(|e| initial_mesh_error(expert, e))?;
+        part.inputs = expert.read_inputs()?;
+        Ok(part)
     }
 }
 
@@ -330,7 +360,10 @@ impl FolderDomain<2> for PlanarPart {
             None => polygon_domain_of_mesh(&expert.path, &expert.mesh)?,
         };
         check_geometry(expert, domain.bounding_box(), domain.area())?;
-        PlanarPart::new(expert.name.clone(), domain, initial_size).map_err(|e| initial_mesh_error(expert, e))
+        let mut part =
+            PlanarPart::new(expert.name.clone(), domain, initial_size).map_err(|e| initial_mesh_error(expert, e))?;
+        part.inputs = expert.read_inputs()?;
+        Ok(part)
     }
 }
 
@@ -341,13 +374,28 @@ pub fn problems<const D: usize, P: FolderDomain<D>>(
     initial_size: f64,
     settings: &DatasetSettings,
 ) -> Result<Vec<WithExpert<P, D>>, TaskError> {
-    experts
+    let paths: Vec<PathBuf> = experts.iter().map(|e| e.inputs.clone().unwrap_or_else(|| e.path.clone())).collect();
+    let problems: Vec<WithExpert<P, D>> = experts
         .into_par_iter()
         .map(|expert| {
             let domain = P::from_expert(&expert, initial_size, settings)?;
             Ok(WithExpert { domain, expert_mesh: expert.mesh })
         })
-        .collect()
+        .collect::<Result<_, TaskError>>()?;
+    // A model reads the same inputs on every part.
+    if let Some(first) = problems.first() {
+        let names = first.optional_inputs();
+        if let Some(k) = problems.iter().position(|p| p.optional_inputs() != names) {
+            let message = format!(
+                "its part inputs ({}) differ from those of {} ({}): every part of a dataset needs the same",
+                problems[k].optional_inputs().join(", "),
+                paths[0].display(),
+                names.join(", ")
+            );
+            return Err(TaskError::Dataset { path: paths[k].clone(), message });
+        }
+    }
+    Ok(problems)
 }
 
 /// Parts of each split of [`write_demo_dataset`].
@@ -403,6 +451,7 @@ pub fn write_demo_dataset(dir: &Path, seed: u64) -> Result<(), TaskError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::part::GEOMETRY_INPUTS;
     use crate::problem::Problem;
 
     fn temp_dir(name: &str) -> PathBuf {
@@ -479,6 +528,46 @@ mod tests {
         std::fs::write(dir.join(SETTINGS_FILE), r#"{"initial_size": -1}"#).unwrap();
         let err = message(DatasetSettings::read(&dir).unwrap_err());
         assert!(err.contains(SETTINGS_FILE), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Parts' own inputs become node inputs of every element; a part whose inputs differ from the
+    /// others', and an inputs file that is not one, are errors naming the file.
+    #[test]
+    fn part_inputs_are_read_and_checked() {
+        let dir = temp_dir("inputs");
+        write_demo_dataset(&dir, 4).unwrap();
+        let train = Split::Train.dir(&dir);
+        let stems = ["plate00", "plate01", "plate02"];
+        for (k, stem) in stems.iter().enumerate() {
+            let inputs = format!(r#"{{"clamp": [0.1, {k}], "load": {}}}"#, k + 1);
+            std::fs::write(train.join(format!("{stem}{PART_INPUTS_SUFFIX}")), inputs).unwrap();
+        }
+        let load = || problems::<2, PlanarPart>(read_experts(&train, None)?, 0.2, &DatasetSettings::default());
+        let parts = load().unwrap();
+        assert_eq!(parts.len(), 3, "an inputs file is not a part");
+        let offered = parts[2].optional_inputs();
+        assert_eq!(offered[GEOMETRY_INPUTS.len()..], ["load".to_owned(), "log_distance_to_clamp".to_owned()]);
+        let part = &parts[2].domain;
+        let columns = part.columns(&part.initial_mesh).unwrap();
+        let column = |name: &str| &columns.iter().find(|c| c.name == name).unwrap().values;
+        assert!(column("load").iter().all(|&x| x == 3.0));
+        for (e, &value) in column("log_distance_to_clamp").iter().enumerate() {
+            let [x, y] = part.initial_mesh.midpoint(e);
+            assert!((value - (x - 0.1).hypot(y - 2.0).ln()).abs() < 1e-12);
+        }
+
+        let odd = train.join(format!("plate01{PART_INPUTS_SUFFIX}"));
+        std::fs::write(&odd, r#"{"clamp": [0.1, 1]}"#).unwrap();
+        let err = load().unwrap_err().to_string();
+        assert!(err.contains("plate01.inputs.json") && err.contains("differ"), "{err}");
+        for (text, what) in
+            [("[1, 2]", "JSON object"), (r#"{"clamp": [0.1, 1, 2]}"#, "point"), (r#"{"load": "x"}"#, "number")]
+        {
+            std::fs::write(&odd, text).unwrap();
+            let err = load().unwrap_err().to_string();
+            assert!(err.contains("plate01.inputs.json") && err.contains(what), "{text}: {err}");
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -4,6 +4,7 @@
 //! meshes) meshes any part of its dimension; every problem of a folder dataset is one with its
 //! expert's mesh.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use amber_graph::FeatureSet;
@@ -119,6 +120,72 @@ fn geometry_columns<const D: usize>(
         .collect()
 }
 
+/// The file beside a part's expert mesh (or geometry) that holds its inputs: `<stem>.inputs.json`.
+pub const PART_INPUTS_SUFFIX: &str = ".inputs.json";
+
+/// Inputs a part has beyond its geometry, from `<stem>.inputs.json`: named scalars (a load, a
+/// material constant) and named points (an inlet, a clamp) that decide where an expert refines.
+/// Each becomes a node input of every element, a scalar as it is and a point `p` as
+/// `log_distance_to_<p>`, the log distance from the element's midpoint.
+///
+/// ```json
+/// {"pressure": 2.5, "inlet": [10.0, 0.0, 42.0]}
+/// ```
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PartInputs<const D: usize> {
+    scalars: BTreeMap<String, f64>,
+    points: BTreeMap<String, [f64; D]>,
+}
+
+impl<const D: usize> PartInputs<D> {
+    /// Reads a part's inputs file: a JSON object whose values are finite numbers or points of `D`
+    /// finite coordinates.
+    pub fn read(path: &Path) -> Result<Self, TaskError> {
+        let value: serde_json::Value = amber_stdx::read_json(path)?;
+        let invalid = |message: String| TaskError::Dataset { path: path.into(), message };
+        let serde_json::Value::Object(entries) = value else {
+            return Err(invalid("part inputs must be a JSON object of named numbers and points".into()));
+        };
+        let mut inputs = Self::default();
+        for (name, value) in entries {
+            let number = |v: &serde_json::Value| v.as_f64().filter(|x| x.is_finite());
+            match &value {
+                serde_json::Value::Array(coordinates) if coordinates.len() == D => {
+                    let point: Option<Vec<f64>> = coordinates.iter().map(number).collect();
+                    let point = point.ok_or_else(|| invalid(format!("`{name}`: a point of finite coordinates")))?;
+                    inputs.points.insert(name, std::array::from_fn(|k| point[k]));
+                }
+                _ => match number(&value) {
+                    Some(x) => {
+                        inputs.scalars.insert(name, x);
+                    }
+                    None => {
+                        return Err(invalid(format!("`{name}`: {value} is neither a finite number nor a {D}D point")));
+                    }
+                },
+            }
+        }
+        Ok(inputs)
+    }
+
+    /// The names of the columns these inputs give, in the order [`Self::columns`] gives them.
+    pub fn names(&self) -> Vec<String> {
+        let points = self.points.keys().map(|name| format!("log_distance_to_{name}"));
+        self.scalars.keys().cloned().chain(points).collect()
+    }
+
+    /// The columns on the elements with midpoints `midpoints`; distances are floored at 10⁻⁶ of
+    /// the geometry's extent `extent` before the logarithm.
+    fn columns(&self, midpoints: &[[f64; D]], extent: f64) -> Vec<Column> {
+        let scalars = self.scalars.values().map(|&x| vec![x; midpoints.len()]);
+        let points = self.points.values().map(|q| {
+            let distance = |p: &[f64; D]| p.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+            midpoints.iter().map(|p| distance(p).max(1e-6 * extent).ln()).collect()
+        });
+        self.names().into_iter().zip(scalars.chain(points)).map(|(name, values)| Column { name, values }).collect()
+    }
+}
+
 /// The length of the diagonal of a bounding box.
 fn diagonal<const D: usize>((min, max): ([f64; D], [f64; D])) -> f64 {
     min.iter().zip(&max).map(|(a, b)| (b - a) * (b - a)).sum::<f64>().sqrt()
@@ -133,6 +200,8 @@ pub struct SolidPart {
     pub surface: Surface,
     /// M⁰: a uniform mesh of the solid.
     pub initial_mesh: Mesh3,
+    /// The part's own inputs (none unless given).
+    pub inputs: PartInputs<3>,
     distance: SurfaceDistance,
 }
 
@@ -143,7 +212,7 @@ impl SolidPart {
         let params = Mesh3dParams { curvature_tolerance: f64::INFINITY, size_factor: 1.0, ..Mesh3dParams::default() };
         let initial_mesh = generate_3d(&surface, &ConstantSize(initial_size), &params)?;
         let distance = SurfaceDistance::new(&surface);
-        Ok(Self { name, surface, initial_mesh, distance })
+        Ok(Self { name, surface, initial_mesh, inputs: PartInputs::default(), distance })
     }
 }
 
@@ -153,19 +222,23 @@ impl Domain<3> for SolidPart {
         FeatureSet::console()
     }
 
-    fn optional_inputs(&self) -> &'static [&'static str] {
-        &GEOMETRY_INPUTS
+    fn optional_inputs(&self) -> Vec<String> {
+        GEOMETRY_INPUTS.iter().map(|name| (*name).to_owned()).chain(self.inputs.names()).collect()
     }
 
     fn initial_mesh(&self) -> &Mesh<3> {
         &self.initial_mesh
     }
 
-    /// The [`GEOMETRY_INPUTS`]; the feature set's own features are computed by the graph.
+    /// The [`GEOMETRY_INPUTS`] and the part's inputs; the feature set's own features are
+    /// computed by the graph.
     fn columns(&self, mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
         let extent = amber_mesh::bounding_box(self.surface.vertices()).map_or(1.0, diagonal);
-        let distance = &self.distance;
-        Ok(geometry_columns(&mesh.midpoints(), extent, |p| distance.to_surface(p), |p| distance.to_feature_curve(p)))
+        let (midpoints, distance) = (mesh.midpoints(), &self.distance);
+        let mut columns =
+            geometry_columns(&midpoints, extent, |p| distance.to_surface(p), |p| distance.to_feature_curve(p));
+        columns.extend(self.inputs.columns(&midpoints, extent));
+        Ok(columns)
     }
 
     fn remesh(&self, mesh: &Mesh<3>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<3>, ProblemError> {
@@ -184,6 +257,8 @@ pub struct PlanarPart {
     pub domain: PolygonDomain,
     /// M⁰: a uniform mesh of the domain.
     pub initial_mesh: Mesh2,
+    /// The part's own inputs (none unless given).
+    pub inputs: PartInputs<2>,
     distance: PolygonDistance,
 }
 
@@ -192,7 +267,7 @@ impl PlanarPart {
     pub fn new(name: String, domain: PolygonDomain, initial_size: f64) -> Result<Self, MeshgenError> {
         let initial_mesh = uniform_mesh_2d(&domain, initial_size, &Mesh2dParams::default())?;
         let distance = PolygonDistance::new(&domain);
-        Ok(Self { name, domain, initial_mesh, distance })
+        Ok(Self { name, domain, initial_mesh, inputs: PartInputs::default(), distance })
     }
 }
 
@@ -202,19 +277,22 @@ impl Domain<2> for PlanarPart {
         FeatureSet::console()
     }
 
-    fn optional_inputs(&self) -> &'static [&'static str] {
-        &GEOMETRY_INPUTS
+    fn optional_inputs(&self) -> Vec<String> {
+        GEOMETRY_INPUTS.iter().map(|name| (*name).to_owned()).chain(self.inputs.names()).collect()
     }
 
     fn initial_mesh(&self) -> &Mesh<2> {
         &self.initial_mesh
     }
 
-    /// The [`GEOMETRY_INPUTS`]; the feature set's own features are computed by the graph.
+    /// The [`GEOMETRY_INPUTS`] and the part's inputs; the feature set's own features are
+    /// computed by the graph.
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
         let extent = diagonal(self.domain.bounding_box());
-        let distance = &self.distance;
-        Ok(geometry_columns(&mesh.midpoints(), extent, |p| distance.to_boundary(p), |p| distance.to_corner(p)))
+        let (midpoints, distance) = (mesh.midpoints(), &self.distance);
+        let mut columns = geometry_columns(&midpoints, extent, |p| distance.to_boundary(p), |p| distance.to_corner(p));
+        columns.extend(self.inputs.columns(&midpoints, extent));
+        Ok(columns)
     }
 
     fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {

@@ -48,8 +48,8 @@ pub trait Domain<const D: usize>: Sync {
     fn feature_set(&self) -> FeatureSet;
     /// Names of the columns this task computes beyond its feature set, which a model may take as
     /// extra node inputs (see [`with_inputs`]); [`LOG_SIZE_COLUMN`] is offered by every task.
-    fn optional_inputs(&self) -> &'static [&'static str] {
-        &[]
+    fn optional_inputs(&self) -> Vec<String> {
+        Vec::new()
     }
     /// M⁰, the start of every rollout.
     fn initial_mesh(&self) -> &Mesh<D>;
@@ -80,7 +80,7 @@ impl<const D: usize, P: Domain<D>> Domain<D> for WithExpert<P, D> {
         self.domain.feature_set()
     }
 
-    fn optional_inputs(&self) -> &'static [&'static str] {
+    fn optional_inputs(&self) -> Vec<String> {
         self.domain.optional_inputs()
     }
 

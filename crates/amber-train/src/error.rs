@@ -42,6 +42,10 @@ pub enum TrainError {
     /// are not positive) or that do not fit its network; the message names the field.
     #[error("{path}: {message}")]
     InvalidModel { path: PathBuf, message: String },
+    /// The model reads node inputs that the domain it should mesh does not offer (e.g. a part's
+    /// own inputs, which its `<stem>.inputs.json` gives).
+    #[error("the model reads the input{} {} that the domain does not offer", if .0.len() == 1 { "" } else { "s" }, .0.join(", "))]
+    MissingInputs(Vec<String>),
     /// A checkpoint is missing a piece or does not fit the run it should resume.
     #[error("checkpoint {path}: {message}")]
     Checkpoint { path: PathBuf, message: String },

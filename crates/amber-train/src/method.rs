@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use amber_tasks::{Domain, MeshLimits, Problem};
+use amber_graph::NodeFeature;
+use amber_tasks::{Domain, LOG_SIZE_COLUMN, MeshLimits, Problem};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError};
@@ -142,6 +143,9 @@ impl TrainedModel {
         evaluation: &Evaluation<'_, D, P>,
         steps: usize,
     ) -> Result<Vec<Rollout<D>>> {
+        if let Some(problem) = evaluation.problems.first() {
+            self.check_inputs(problem)?;
+        }
         match self {
             TrainedModel::Amber(m) => Ok(evaluation.run(&m.sizing(), steps)?.0),
             TrainedModel::Cnn(m) => Ok(evaluation.run(&m.sizing(), steps)?.0),
@@ -156,6 +160,7 @@ impl TrainedModel {
         steps: usize,
         target: Option<ElementTarget>,
     ) -> Result<Vec<GeneratedStep<D>>> {
+        self.check_inputs(domain)?;
         match self {
             TrainedModel::Amber(m) => generate(&m.sizing(), domain, steps, target),
             TrainedModel::Cnn(m) => generate(&m.sizing(), domain, steps, target),
@@ -185,6 +190,25 @@ impl TrainedModel {
         let path = dir.join(file);
         let json = json.map_err(|source| TrainError::Json { path: path.clone(), source })?;
         Ok(amber_stdx::write_json_atomic(&path, &json)?)
+    }
+
+    /// Whether `domain` offers every per-element column the model reads beyond the geometric
+    /// features and log h(K) (the CNN reads none).
+    pub fn check_inputs<const D: usize, P: Domain<D>>(&self, domain: &P) -> Result<()> {
+        let TrainedModel::Amber(m) = self else { return Ok(()) };
+        let (own, offered) = (domain.feature_set(), domain.optional_inputs());
+        let missing: Vec<String> = m
+            .predictor
+            .features
+            .node
+            .iter()
+            .filter(|&f| !own.node.contains(f))
+            .filter_map(|f| match f {
+                NodeFeature::Column(name) if name != LOG_SIZE_COLUMN && !offered.contains(name) => Some(name.clone()),
+                _ => None,
+            })
+            .collect();
+        if missing.is_empty() { Ok(()) } else { Err(TrainError::MissingInputs(missing)) }
     }
 
     /// h_min and the element budget.

@@ -36,8 +36,8 @@ impl Domain<2> for PoissonProblem {
         FeatureSet::poisson()
     }
 
-    fn optional_inputs(&self) -> &'static [&'static str] {
-        OPTIONAL_INPUTS
+    fn optional_inputs(&self) -> Vec<String> {
+        OPTIONAL_INPUTS.iter().map(|name| (*name).to_owned()).collect()
     }
 
     fn initial_mesh(&self) -> &Mesh<2> {
@@ -93,8 +93,8 @@ impl Domain<2> for PoissonPart {
         FeatureSet::poisson()
     }
 
-    fn optional_inputs(&self) -> &'static [&'static str] {
-        OPTIONAL_INPUTS
+    fn optional_inputs(&self) -> Vec<String> {
+        OPTIONAL_INPUTS.iter().map(|name| (*name).to_owned()).collect()
     }
 
     fn initial_mesh(&self) -> &Mesh<2> {

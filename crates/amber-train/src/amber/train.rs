@@ -105,12 +105,14 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
     pub fn new(config: TrainingConfig, problems: Vec<P>) -> Result<Self> {
         config.validate()?;
         let first = problems.first().ok_or(TrainError::NoProblems)?;
-        let offered = first.optional_inputs();
-        if let Some(unknown) = config.inputs.iter().find(|i| *i != LOG_SIZE_COLUMN && !offered.contains(&i.as_str())) {
-            return Err(TrainError::InvalidConfig(format!(
-                "inputs: the task offers no input `{unknown}` (it offers {LOG_SIZE_COLUMN}{})",
-                offered.iter().map(|o| format!(", {o}")).collect::<String>()
-            )));
+        for (k, problem) in problems.iter().enumerate() {
+            let offered = problem.optional_inputs();
+            if let Some(unknown) = config.inputs.iter().find(|i| *i != LOG_SIZE_COLUMN && !offered.contains(i)) {
+                return Err(TrainError::InvalidConfig(format!(
+                    "inputs: training problem {k} offers no input `{unknown}` (it offers {LOG_SIZE_COLUMN}{})",
+                    offered.iter().map(|o| format!(", {o}")).collect::<String>()
+                )));
+            }
         }
         let features = with_inputs(first.feature_set(), &config.inputs);
         let limits = MeshLimits::from_experts(
