@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use super::model::{CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnModel, CnnPredictor, Rasterised, rasterise, transpose};
 use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, fingerprints, seeded_stream};
 use crate::error::{Result, TrainError, in_problem, io_error};
-use crate::{BufferEntry, CnnConfig};
+use crate::{BufferEntry, CnnConfig, StepReport, TrainingObserver};
 
 /// One gradient step of a CNN run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -38,18 +38,6 @@ pub struct CnnStepReport {
     /// Wall time of the step.
     pub seconds: f64,
 }
-
-/// Progress callbacks of [`CnnTraining::run`] (the library never prints). Every method has an
-/// empty default.
-pub trait CnnObserver {
-    /// After every gradient step.
-    fn step(&mut self, _report: &CnnStepReport, _total_steps: u64) {}
-    /// After every checkpoint.
-    fn checkpoint(&mut self, _step: u64, _dir: &Path) {}
-}
-
-/// Observes nothing.
-impl CnnObserver for () {}
 
 /// `state.json` of a CNN checkpoint.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -244,12 +232,12 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
     /// Trains until `config.steps` from wherever the run stands, checkpoints every
     /// `checkpoint_interval` steps and at the end, and writes the final model to
     /// `out_dir/model`, which it returns.
-    pub fn run(&mut self, out_dir: &Path, observer: &mut dyn CnnObserver) -> Result<PathBuf> {
+    pub fn run(&mut self, out_dir: &Path, observer: &mut dyn TrainingObserver) -> Result<PathBuf> {
         std::fs::create_dir_all(out_dir).map_err(io_error(out_dir))?;
         write_json_atomic(&out_dir.join(crate::CONFIG_FILE), &self.config)?;
         while self.step < self.config.steps {
             let report = self.train_step()?;
-            observer.step(&report, self.config.steps);
+            observer.step(&StepReport::Cnn(report), self.config.steps);
             if self.step.is_multiple_of(self.config.checkpoint_interval) || self.step == self.config.steps {
                 let dir = self.save_checkpoint(out_dir)?;
                 observer.checkpoint(self.step, &dir);
