@@ -135,18 +135,20 @@ fn bench_case(
     let lr = paper.learning_rate;
     let frozen = model.for_inference();
     let mut rng = StdRng::seed_from_u64(0);
+    // The paper's objective: a softplus on the output.
+    let softplus = |z: Tensor| paper.objective.activation(&z);
     let mut step = || -> anyhow::Result<()> {
         match (variant, mode) {
-            ("naive", "infer") => drop(frozen.forward_naive(&graph)?),
-            ("fast", "infer") => drop(frozen.forward(&graph)?),
+            ("naive", "infer") => drop(softplus(frozen.forward_naive(&graph)?)?),
+            ("fast", "infer") => drop(softplus(frozen.forward(&graph)?)?),
             ("naive", "train") => {
-                adam.step(&mse(&model.forward_naive(&graph)?, &targets)?, lr)?;
+                adam.step(&mse(&softplus(model.forward_naive(&graph)?)?, &targets)?, lr)?;
             }
             ("fast", "train") => {
-                adam.step(&mse(&model.forward(&graph)?, &targets)?, lr)?;
+                adam.step(&mse(&softplus(model.forward(&graph)?)?, &targets)?, lr)?;
             }
             ("fast-dropout", "train") => {
-                adam.step(&mse(&model.forward_train(&graph, &mut rng)?, &targets)?, lr)?;
+                adam.step(&mse(&softplus(model.forward_train(&graph, &mut rng)?)?, &targets)?, lr)?;
             }
             _ => bail!("unknown variant/mode {variant}/{mode}"),
         }

@@ -33,9 +33,9 @@ mod rollout;
 
 pub use amber::{
     Addition, AmberModel, AmberSizing, AmberStepReport, BufferEntry, CONFIG_FILE, LOG_FILE, MODEL_DIR, NetworkConfig,
-    Objective, Predictor, ReplayBuffer, Sample, SourceSelection, TargetTransform, Training, TrainingConfig,
-    WEIGHTS_FILE, softplus, softplus_inverse,
+    Predictor, ReplayBuffer, Sample, SourceSelection, TargetTransform, Training, TrainingConfig, WEIGHTS_FILE,
 };
+pub use amber_nn::Objective;
 pub use checkpoint::{AdditionCounts, CHECKPOINTS_DIR, latest_checkpoint};
 pub use cnn::{
     CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnConfig, CnnModel, CnnPredictor, CnnSizing, CnnStepReport, CnnTraining,

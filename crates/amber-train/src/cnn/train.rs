@@ -102,7 +102,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         let inside_targets: Vec<f32> = samples
             .iter()
             .flat_map(|(sample, labels)| {
-                sample.raster.owners.iter().flatten().map(|&e| config.loss.target(labels[e as usize]) as f32)
+                sample.raster.owners.iter().flatten().map(|&e| config.objective.target(labels[e as usize], None) as f32)
             })
             .collect();
         let label_moments = config
@@ -116,7 +116,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         let predictor = CnnPredictor {
             network: config.network::<D>(channels),
             resolution: config.resolution,
-            loss: config.loss,
+            objective: config.objective,
             normaliser,
             label_moments,
             limits,
@@ -147,7 +147,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
     pub fn new(config: CnnConfig, problems: Vec<P>) -> Result<Self> {
         let (network, predictor, images) =
             Self::prepare(&config, &problems, |p| Ok(UNet::init(p.network.clone(), config.seed)?))?;
-        let trainer = CnnTrainer::new(network, images, config.loss, config.max_grad_norm)?;
+        let trainer = CnnTrainer::new(network, images, config.objective, config.max_grad_norm)?;
         Ok(Self { subset_rng: seeded_stream(config.seed, 3), config, problems, trainer, predictor, step: 0 })
     }
 
@@ -176,7 +176,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         if saved != predictor {
             return Err(fail("the rasterised problems give another normaliser or limits than the checkpointed run's"));
         }
-        let mut trainer = CnnTrainer::new(network, images, config.loss, config.max_grad_norm)?;
+        let mut trainer = CnnTrainer::new(network, images, config.objective, config.max_grad_norm)?;
         trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         Ok(Self { subset_rng: state.subset_rng.restore(dir)?, config, problems, trainer, predictor, step: state.step })
     }
