@@ -10,6 +10,7 @@
 //! This crate sees meshes only to rasterise them and knows nothing of FEM, mesh generation, the
 //! training loop or metrics: those live in `amber-train`, which drives it.
 
+pub mod bench;
 mod error;
 pub mod ops;
 mod raster;

@@ -113,7 +113,7 @@ impl CnnTrainer {
 
 /// Mean over the pixels where `mask` is 1 (0 elsewhere) of the squared difference between
 /// `prediction` and `targets`; all three tensors have the same shape.
-fn masked_mse(prediction: &Tensor, targets: &Tensor, mask: &Tensor) -> Result<Tensor> {
+pub(crate) fn masked_mse(prediction: &Tensor, targets: &Tensor, mask: &Tensor) -> Result<Tensor> {
     let squared = ((prediction - targets)?.sqr()? * mask)?;
     let inside = mask.sum_all()?.maximum(1.0)?;
     Ok(squared.sum_all()?.div(&inside)?)

@@ -23,6 +23,7 @@
 //! # Ok::<(), amber_mpn::MpnError>(())
 //! ```
 
+pub mod bench;
 mod config;
 mod error;
 mod graph;
