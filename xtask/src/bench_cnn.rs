@@ -7,14 +7,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use amber_cnn::{CnnLoss, UNet, UNetConfig};
-use amber_nn::Adam;
+use amber_cnn::UNetConfig;
+use amber_cnn::bench::BenchCase;
 use amber_stdx::median;
 use amber_train::CnnConfig;
 use anyhow::{Context, bail};
-use candle_core::{DType, Device, Tensor};
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
 use serde_json::{Value, json};
 
 use crate::report;
@@ -122,50 +119,28 @@ fn bench_ours(case: &Case, args: &Args) -> anyhow::Result<Value> {
         initial_channels: args.channels,
         depth: 4,
     };
-    let net = UNet::init(config, 0)?;
-    let spatial = vec![case.resolution; case.spatial_axes];
-    let input_shape: Vec<usize> = [1, case.in_channels].into_iter().chain(spatial.iter().copied()).collect();
-    let label_shape: Vec<usize> = [1, 1].into_iter().chain(spatial.iter().copied()).collect();
-    let mut rng = StdRng::seed_from_u64(0);
-    let mut random = |shape: &[usize], lo: f32, hi: f32| {
-        let v: Vec<f32> = (0..shape.iter().product()).map(|_| rng.random_range(lo..hi)).collect();
-        Tensor::from_vec(v, shape, &Device::Cpu)
-    };
-    let x = random(&input_shape, -1.0, 1.0)?;
-    let y = random(&label_shape, 0.0, 1.0)?;
-    let mask = Tensor::ones(label_shape.as_slice(), DType::F32, &Device::Cpu)?;
-    // The Adam that trains, with the paper's settings.
+    // The Adam that trains, with the paper's settings; its log-MSE is a plain MSE of the output.
     let paper = CnnConfig::paper();
-    let mut adam = Adam::new(net.varmap(), paper.max_grad_norm)?;
+    let mut bench = BenchCase::new(config, case.resolution, paper.objective, paper.learning_rate, paper.max_grad_norm)?;
     let mut forward_s = Vec::new();
-    let mut train_step = || -> anyhow::Result<()> {
-        let started = Instant::now();
-        let loss = CnnLoss::Mse.loss(&net.forward_train(&x)?, &y, &mask)?;
-        forward_s.push(started.elapsed().as_secs_f64());
-        adam.step(&loss, paper.learning_rate)?;
-        Ok(())
-    };
     let load_average_before = load_average();
-    let train = time(args, &mut train_step)?;
+    let train = time(args, &mut || -> anyhow::Result<()> {
+        forward_s.push(bench.train_step()?);
+        Ok(())
+    })?;
     // The timed steps' forward passes (after the warm-up).
     let forward_s = forward_s.split_off(args.warmup.min(forward_s.len()));
     // Forward and backward without the optimiser: the rest of a step is clipping and Adam.
     let mut backward_s = Vec::new();
     time(args, &mut || -> anyhow::Result<()> {
-        let loss = CnnLoss::Mse.loss(&net.forward_train(&x)?, &y, &mask)?;
-        let started = Instant::now();
-        drop(loss.backward()?);
-        backward_s.push(started.elapsed().as_secs_f64());
+        backward_s.push(bench.backward()?);
         Ok(())
     })?;
     let backward_s = backward_s.split_off(args.warmup.min(backward_s.len()));
-    let infer = time(args, &mut || -> anyhow::Result<()> {
-        drop(net.forward(&x)?);
-        Ok(())
-    })?;
+    let infer = time(args, &mut || Ok(bench.infer()?))?;
     Ok(json!({
-        "input_shape": input_shape,
-        "parameters": net.parameter_count(),
+        "input_shape": bench.input_shape(),
+        "parameters": bench.parameter_count(),
         "train_s_median": median(&train),
         "train_s_all": train,
         "train_forward_s_median": median(&forward_s),

@@ -6,16 +6,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use amber_mpn::synthetic::random_graph;
-use amber_mpn::{GraphInput, Mpn, MpnConfig};
-use amber_nn::Adam;
+use amber_mpn::MpnConfig;
+use amber_mpn::bench::{BenchCase, BenchStep, candle_threads};
 use amber_stdx::median;
 use amber_train::TrainingConfig;
 use anyhow::{Context, bail};
-use candle_core::{DType, Device, Tensor};
-use candle_nn::loss::mse;
-use rand::SeedableRng;
-use rand::rngs::StdRng;
 use serde_json::{Value, json};
 
 use crate::timing::{CLOCK_TICKS_PER_S, CpuClock, CpuTimer};
@@ -92,7 +87,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "train": { "learning_rate": paper.learning_rate, "max_grad_norm": paper.max_grad_norm },
         "graph": { "nodes": args.nodes, "directed_edges": args.edges, "self_loops": args.nodes, "generator": "amber_mpn::synthetic::random_graph (uniform random pairs, both directions, dst-sorted)" },
         "rayon_threads": rayon::current_num_threads(),
-        "candle_threads": candle_core::utils::get_num_threads(),
+        "candle_threads": candle_threads(),
         "iters": args.iters,
         "warmup": args.warmup,
         "machine": crate::report::machine(),
@@ -111,7 +106,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// Times one (variant, mode): `infer` is a forward of a plain-tensor model, `train` is forward,
 /// MSE, backward, global-norm clipping and a step of the Adam that trains, with the paper's
-/// settings (0.5, 3e-4).
+/// objective and settings (softplus, 0.5, 3e-4).
 fn bench_case(
     config: &MpnConfig,
     paper: &TrainingConfig,
@@ -121,37 +116,17 @@ fn bench_case(
     edges: usize,
     args: &Args,
 ) -> anyhow::Result<Value> {
-    let dev = Device::Cpu;
-    let graph = GraphInput::from_batch(
-        &random_graph(nodes, edges / 2, config.node_features, config.edge_features, 0),
-        DType::F32,
-        &dev,
-    )?;
-    // Sizing-field-like positive targets in [0.01, 0.06), deterministic.
-    let targets: Vec<f32> = (0..nodes).map(|i| 0.01 + 0.05 * ((i as f32 * 0.618_034) % 1.0)).collect();
-    let targets = Tensor::from_vec(targets, nodes, &dev)?;
-    let (model, varmap) = Mpn::init(config.clone(), 0, DType::F32, &dev)?;
-    let mut adam = Adam::new(&varmap, paper.max_grad_norm)?;
-    let lr = paper.learning_rate;
-    let frozen = model.for_inference();
-    let mut rng = StdRng::seed_from_u64(0);
-    let mut step = || -> anyhow::Result<()> {
-        match (variant, mode) {
-            ("naive", "infer") => drop(frozen.forward_naive(&graph)?),
-            ("fast", "infer") => drop(frozen.forward(&graph)?),
-            ("naive", "train") => {
-                adam.step(&mse(&model.forward_naive(&graph)?, &targets)?, lr)?;
-            }
-            ("fast", "train") => {
-                adam.step(&mse(&model.forward(&graph)?, &targets)?, lr)?;
-            }
-            ("fast-dropout", "train") => {
-                adam.step(&mse(&model.forward_train(&graph, &mut rng)?, &targets)?, lr)?;
-            }
-            _ => bail!("unknown variant/mode {variant}/{mode}"),
-        }
-        Ok(())
+    let kind = match (variant, mode) {
+        ("naive", "infer") => BenchStep::NaiveInfer,
+        ("fast", "infer") => BenchStep::FastInfer,
+        ("naive", "train") => BenchStep::NaiveTrain,
+        ("fast", "train") => BenchStep::FastTrain,
+        ("fast-dropout", "train") => BenchStep::FastDropoutTrain,
+        _ => bail!("unknown variant/mode {variant}/{mode}"),
     };
+    let mut bench =
+        BenchCase::new(config, paper.objective, nodes, edges / 2, paper.learning_rate, paper.max_grad_norm)?;
+    let mut step = || bench.run(kind);
     let peak_reset = reset_peak_rss();
     for _ in 0..args.warmup {
         step()?;
@@ -170,7 +145,7 @@ fn bench_case(
         "variant": variant,
         "mode": mode,
         "n_nodes": nodes,
-        "n_edges": graph.topology.num_edges(),
+        "n_edges": bench.num_edges(),
         "s_median": s_median,
         "s_min": times.iter().copied().fold(f64::INFINITY, f64::min),
         "s_all": times,

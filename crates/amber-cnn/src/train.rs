@@ -1,15 +1,15 @@
 //! Training the U-Net behind plain slices: [`TrainingImages`] holds a run's stacked images as
 //! tensors, built from `Vec<f32>`s; [`CnnTrainer`] owns the network, the images and the Adam
-//! optimiser and takes one step (training forward, masked loss, backward, clipping, update) on
-//! all images or a subset.
+//! optimiser and takes one step (training forward, the objective's mean squared error over the
+//! pixels inside the geometry, backward, clipping, update) on all images or a subset.
 
 use std::path::Path;
 
-use amber_nn::Adam;
+use amber_nn::{Adam, Objective};
 use candle_core::{Device, Tensor};
 
+use crate::UNet;
 use crate::error::{CnnError, Result};
-use crate::{CnnLoss, UNet};
 
 /// A run's training images, stacked: inputs `(N, C, spatial...)`, targets and masks
 /// `(N, 1, spatial...)` (mask 1 inside the geometry, 0 outside).
@@ -50,20 +50,25 @@ pub struct CnnStep {
     pub images: usize,
 }
 
-/// A trainable U-Net with its training images, loss and optimiser.
+/// A trainable U-Net with its training images, objective and optimiser.
 pub struct CnnTrainer {
     network: UNet,
     images: TrainingImages,
-    loss: CnnLoss,
+    objective: Objective,
     optimiser: Adam,
 }
 
 impl CnnTrainer {
-    /// Fresh moments for every variable of `network`; gradients are clipped to a global norm of
-    /// `max_grad_norm` if set.
-    pub fn new(network: UNet, images: TrainingImages, loss: CnnLoss, max_grad_norm: Option<f64>) -> Result<Self> {
+    /// Trains `network` for `objective` (whose targets `images` hold), with fresh moments for
+    /// every variable; gradients are clipped to a global norm of `max_grad_norm` if set.
+    pub fn new(
+        network: UNet,
+        images: TrainingImages,
+        objective: Objective,
+        max_grad_norm: Option<f64>,
+    ) -> Result<Self> {
         let optimiser = Adam::new(network.varmap(), max_grad_norm)?;
-        Ok(Self { network, images, loss, optimiser })
+        Ok(Self { network, images, objective, optimiser })
     }
 
     /// Restores the moments written by [`Self::save_optimiser`] and the count of updates taken.
@@ -99,9 +104,37 @@ impl CnnTrainer {
         let images = &self.images;
         let (inputs, targets, masks) = (pick(&images.inputs)?, pick(&images.targets)?, pick(&images.masks)?);
         let output = self.network.forward_train(&inputs)?;
-        let loss = self.loss.loss(&output, &targets, &masks)?;
+        let loss = masked_mse(&self.objective.activation(&output)?, &targets, &masks)?;
         let loss_value = f64::from(loss.to_scalar::<f32>()?);
         let grad_norm = self.optimiser.step(&loss, lr)?;
         Ok(CnnStep { loss: loss_value, grad_norm, images: inputs.dim(0)? })
+    }
+}
+
+/// Mean over the pixels where `mask` is 1 (0 elsewhere) of the squared difference between
+/// `prediction` and `targets`; all three tensors have the same shape.
+pub(crate) fn masked_mse(prediction: &Tensor, targets: &Tensor, mask: &Tensor) -> Result<Tensor> {
+    let squared = ((prediction - targets)?.sqr()? * mask)?;
+    let inside = mask.sum_all()?.maximum(1.0)?;
+    Ok(squared.sum_all()?.div(&inside)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_loss_averages_over_inside_pixels_only() {
+        let dev = Device::Cpu;
+        let out = Tensor::new(&[[0.0f32, 1.0, 5.0]], &dev).unwrap();
+        let targets = Tensor::new(&[[1.0f32, 1.0, -7.0]], &dev).unwrap();
+        let mask = Tensor::new(&[[1.0f32, 1.0, 0.0]], &dev).unwrap();
+        let loss = |objective: Objective| {
+            let prediction = objective.activation(&out).unwrap();
+            masked_mse(&prediction, &targets, &mask).unwrap().to_scalar::<f32>().unwrap()
+        };
+        assert_eq!(loss(Objective::LogMse), 0.5);
+        let expected = ((2f64.ln() - 1.0).powi(2) + (1.0 + (-1f64).exp().ln_1p() - 1.0).powi(2)) / 2.0;
+        assert!((f64::from(loss(Objective::SoftplusMse)) - expected).abs() < 1e-6);
     }
 }

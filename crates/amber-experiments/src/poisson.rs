@@ -116,7 +116,7 @@ impl PoissonExperiment {
         experiment.seeds = 1;
         experiment.difficulties = vec![if profile == Profile::Smoke { Difficulty::Easy } else { Difficulty::Hard }];
         let variant = |method, name: &str, overrides| MethodSpec { method, variant: Variant::new(name, overrides) };
-        let log_loss = serde_json::json!({ "objective": "log" });
+        let log_loss = serde_json::json!({ "objective": "log_mse" });
         experiment.methods = vec![
             MethodSpec::plain(Method::AmberMean),
             MethodSpec::plain(Method::AmberMax),
@@ -125,7 +125,7 @@ impl PoissonExperiment {
             variant(
                 Method::AmberMax,
                 "no-softplus",
-                serde_json::json!({ "objective": "linear", "normalise_labels": false }),
+                serde_json::json!({ "objective": "mse", "normalise_labels": false }),
             ),
             variant(Method::AmberMax, "random-buffer", serde_json::json!({ "source_selection": "uniform" })),
             variant(Method::AmberMax, "no-input-normalisation", serde_json::json!({ "normalise_inputs": false })),

@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use amber_train::{CnnStepReport, EvaluationSummary, StepReport, TrainingObserver};
+use amber_train::{EvaluationSummary, StepReport, TrainingObserver};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Steps between progress lines when no bar can be drawn.
@@ -58,50 +58,42 @@ impl TrainingProgress {
     }
 }
 
-impl TrainingProgress {
-    /// After every gradient step of a CNN run.
-    pub fn cnn_step(&mut self, report: &CnnStepReport, total: u64) {
-        let w = &mut self.window;
-        w.steps += 1;
-        w.loss += report.loss;
-        w.seconds += report.seconds;
-        self.bar.set_position(report.step);
-        let every = if self.bar.is_hidden() { LOG_INTERVAL } else { 5 };
-        if w.steps >= every || report.step == total {
-            let message = format!("loss {:.4}, {:.2} s/step", w.loss / w.steps as f64, w.seconds / w.steps as f64);
-            self.window = Window::default();
-            self.report(report.step, total, message);
-        }
-    }
-
-    fn report(&self, step: u64, total: u64, message: String) {
-        if self.bar.is_hidden() {
-            self.println(&format!("step {step}/{total} ({:.0} s): {message}", self.started.elapsed().as_secs_f64()));
-        } else {
-            self.bar.set_message(message);
-        }
-    }
-}
-
 impl TrainingObserver for TrainingProgress {
     fn step(&mut self, report: &StepReport, total: u64) {
         let w = &mut self.window;
         w.steps += 1;
-        w.loss += report.loss;
-        w.nodes += report.nodes;
-        w.seconds += report.seconds;
-        self.bar.set_position(report.step);
+        w.loss += report.loss();
+        w.seconds += report.seconds();
+        if let StepReport::Amber(r) = report {
+            w.nodes += r.nodes;
+        }
+        let step = report.step();
+        self.bar.set_position(step);
         // Without a terminal (logs, CI) the bar is hidden: print a line every few hundred steps.
-        let every = if self.bar.is_hidden() { LOG_INTERVAL } else { 20 };
-        if w.steps >= every || report.step == total {
-            let message = format!(
-                "loss {:.4}, {:.0} nodes/s, buffer {:?}",
-                w.loss / w.steps as f64,
+        // A CNN step takes seconds, an AMBER step a fraction of one.
+        let every = match (self.bar.is_hidden(), report) {
+            (true, _) => LOG_INTERVAL,
+            (false, StepReport::Amber(_)) => 20,
+            (false, StepReport::Cnn(_)) => 5,
+        };
+        if w.steps < every && step < total {
+            return;
+        }
+        let steps = w.steps as f64;
+        let loss = w.loss / steps;
+        let message = match report {
+            StepReport::Amber(r) => format!(
+                "loss {loss:.4}, {:.0} nodes/s, buffer {:?}",
                 w.nodes as f64 / w.seconds.max(1e-9),
-                report.buffer_depths
-            );
-            self.window = Window::default();
-            self.report(report.step, total, message);
+                r.buffer_depths
+            ),
+            StepReport::Cnn(_) => format!("loss {loss:.4}, {:.2} s/step", w.seconds / steps),
+        };
+        self.window = Window::default();
+        if self.bar.is_hidden() {
+            self.println(&format!("step {step}/{total} ({:.0} s): {message}", self.started.elapsed().as_secs_f64()));
+        } else {
+            self.bar.set_message(message);
         }
     }
 

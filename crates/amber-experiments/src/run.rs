@@ -10,8 +10,8 @@ use amber_stdx::read_json;
 use amber_tasks::MeshLimits;
 use amber_tasks::Problem;
 use amber_train::{
-    CONFIG_FILE, CnnObserver, CnnStepReport, Evaluation, EvaluationSummary, MODEL_DIR, MethodConfig, Rollout,
-    StepReport, TrainedModel, TrainingObserver,
+    CONFIG_FILE, Evaluation, EvaluationSummary, MODEL_DIR, MethodConfig, Rollout, StepReport, TrainedModel,
+    TrainingObserver,
 };
 use anyhow::{Context, bail};
 use serde::{Deserialize, Serialize};
@@ -277,17 +277,6 @@ impl TimedProgress {
         if let Err(e) = write_json(&self.time_path, &time) {
             self.inner.println(&format!("warning: {e:#}"));
         }
-    }
-}
-
-impl CnnObserver for TimedProgress {
-    fn step(&mut self, report: &CnnStepReport, total: u64) {
-        self.inner.cnn_step(report, total);
-    }
-
-    fn checkpoint(&mut self, step: u64, dir: &Path) {
-        TrainingObserver::checkpoint(&mut self.inner, step, dir);
-        self.record();
     }
 }
 

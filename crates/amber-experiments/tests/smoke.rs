@@ -125,8 +125,8 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     // Each variant really changed its run's config.
     let configs = results.config["runs"].as_array().unwrap();
     let training = |k: usize| &configs[k]["training"];
-    assert_eq!(training(2)["amber"]["objective"], "log");
-    assert_eq!(training(4)["amber"]["objective"], "linear");
+    assert_eq!(training(2)["amber"]["objective"], "log_mse");
+    assert_eq!(training(4)["amber"]["objective"], "mse");
     assert_eq!(training(5)["amber"]["source_selection"], "uniform");
     assert_eq!(training(6)["amber"]["normalise_inputs"], false);
     // The ablations run on the paper's network and inputs, the graph context being a variant.

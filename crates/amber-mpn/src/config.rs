@@ -1,26 +1,15 @@
-//! The network's configuration (serde): widths, depth, output transform; the paper's values as defaults.
+//! The network's configuration (serde): widths, depth, dropout; the paper's values as defaults.
 
 use serde::{Deserialize, Serialize};
 
 use crate::error::{MpnError, Result};
 
-/// How the decoder's scalar output `z` becomes the predicted element size.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum OutputTransform {
-    /// `softplus(z)`: the paper's positive size, trained with MSE on raw sizes.
-    #[default]
-    Softplus,
-    /// `z` unchanged (the "no softplus" ablation).
-    None,
-    /// `exp(z)`: for regressing log sizes (`z` is trained against `log y`).
-    Exp,
-}
-
 /// Hyper-parameters of the message passing network (spec §5). The defaults are the paper's
-/// Poisson configuration.
+/// Poisson configuration. Unknown fields are ignored: model files written before the output
+/// transform moved to the trainer's objective (`amber_nn::Objective`) still carry it as
+/// `output`, and the objective beside them says the same.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(default)]
 pub struct MpnConfig {
     /// Input features per node (Poisson: area, mean u, std u, f).
     pub node_features: usize,
@@ -32,7 +21,6 @@ pub struct MpnConfig {
     pub steps: usize,
     /// Probability of dropping each directed edge (self-loops included) in training mode.
     pub edge_dropout: f64,
-    pub output: OutputTransform,
     /// Graph context (off in the paper): every step adds `tanh(W·mean(x) + b)`, the mean node
     /// state of each graph transformed, to its nodes' aggregated messages. Ten steps of message
     /// passing reach ten elements; this gives every element a view of its whole mesh (spec §11's
@@ -52,15 +40,7 @@ impl MpnConfig {
     /// The paper's Poisson network: 4 node features, 1 edge feature, D = 64, L = 10
     /// (300,673 parameters).
     pub fn poisson() -> Self {
-        Self {
-            node_features: 4,
-            edge_features: 1,
-            latent_dim: 64,
-            steps: 10,
-            edge_dropout: 0.1,
-            output: OutputTransform::Softplus,
-            graph_context: false,
-        }
+        Self { node_features: 4, edge_features: 1, latent_dim: 64, steps: 10, edge_dropout: 0.1, graph_context: false }
     }
 
     /// The reference code's Console network: 1 node feature, 3 edge features, D = 128.
@@ -109,14 +89,15 @@ mod tests {
 
     #[test]
     fn json_round_trip_and_defaults() {
-        let c = MpnConfig { output: OutputTransform::Exp, ..MpnConfig::console() };
+        let c = MpnConfig::console();
         let back: MpnConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
         assert_eq!(back, c);
         assert!(!serde_json::to_string(&c).unwrap().contains("graph_context"));
         let on = MpnConfig { graph_context: true, ..c };
         assert_eq!(serde_json::from_str::<MpnConfig>(&serde_json::to_string(&on).unwrap()).unwrap(), on);
+        // Earlier model files name the output transform.
         let partial: MpnConfig = serde_json::from_str(r#"{"latent_dim": 32, "output": "none"}"#).unwrap();
-        assert_eq!(partial, MpnConfig { latent_dim: 32, output: OutputTransform::None, ..MpnConfig::poisson() });
+        assert_eq!(partial, MpnConfig { latent_dim: 32, ..MpnConfig::poisson() });
         assert!(MpnConfig { edge_dropout: 1.0, ..MpnConfig::poisson() }.validate().is_err());
     }
 }

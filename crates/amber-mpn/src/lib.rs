@@ -1,6 +1,7 @@
 //! The message passing network (MPN) of AMBER in candle: it maps a mesh graph (nodes =
-//! elements) to one predicted element size per node (spec §5), and the fused CPU custom ops that
-//! make it fast enough to train on CPUs.
+//! elements) to one scalar per node, an element size through the objective
+//! (`amber_nn::Objective`, spec §5), and the fused CPU custom ops that make it fast enough to
+//! train on CPUs.
 //!
 //! Input is an [`amber_graph::GraphBatch`]; this crate knows nothing of meshes, meshing, labels
 //! or the training loop around a step. [`MpnTrainer`] (one training step: forward, loss, Adam
@@ -9,17 +10,20 @@
 //!
 //! ```
 //! use amber_mpn::{GraphInput, Mpn, MpnConfig};
+//! use amber_nn::Objective;
 //! use candle_core::{DType, Device};
 //!
 //! let config = MpnConfig { latent_dim: 8, steps: 2, ..MpnConfig::poisson() };
 //! let (model, _vars) = Mpn::init(config, 0, DType::F32, &Device::Cpu)?;
 //! let batch = amber_mpn::synthetic::random_graph(10, 15, 4, 1, 0);
-//! let sizes = model.predict(&batch)?;
+//! let z = model.predict(&batch)?;
+//! let sizes: Vec<f64> = z.iter().map(|&z| Objective::SoftplusMse.size(f64::from(z), None)).collect();
 //! assert_eq!(sizes.len(), 10);
-//! assert!(sizes.iter().all(|&h| h > 0.0)); // softplus output
+//! assert!(sizes.iter().all(|&h| h > 0.0));
 //! # Ok::<(), amber_mpn::MpnError>(())
 //! ```
 
+pub mod bench;
 mod config;
 mod error;
 mod graph;
@@ -29,7 +33,7 @@ mod ops;
 pub mod synthetic;
 mod train;
 
-pub use config::{MpnConfig, OutputTransform};
+pub use config::MpnConfig;
 pub use error::{MpnError, Result};
 pub use graph::{GraphInput, Topology};
 pub use model::Mpn;

@@ -1,5 +1,6 @@
 //! The network of spec §5: linear encoders, L message-passing steps with their own weights, and
-//! a tanh MLP decoder with a configurable output transform.
+//! a tanh MLP decoder to one scalar per node, whose meaning (a size, a log size, a residual) is the
+//! trainer's objective (`amber_nn::Objective`).
 
 mod init;
 mod naive;
@@ -12,7 +13,7 @@ use candle_core::{DType, Device, Tensor};
 use candle_nn::{Init, VarBuilder, VarMap};
 use rand::Rng;
 
-use crate::config::{MpnConfig, OutputTransform};
+use crate::config::MpnConfig;
 use crate::error::{MpnError, Result};
 use crate::graph::GraphInput;
 use crate::ops;
@@ -260,7 +261,7 @@ impl Mpn {
         p
     }
 
-    /// Predicted sizes, one per node (evaluation mode: no edge dropout). With `Var` parameters the
+    /// The output z, one per node (evaluation mode: no edge dropout). With `Var` parameters the
     /// result can be differentiated once (the fused ops hand their saved activations to the first
     /// backward pass).
     pub fn forward(&self, graph: &GraphInput) -> Result<Tensor> {
@@ -283,8 +284,8 @@ impl Mpn {
         }
     }
 
-    /// Evaluation-mode predictions for a batch, one per node (on plain tensors: no autograd
-    /// graph is recorded, even for a network of variables).
+    /// Evaluation-mode outputs z for a batch, one per node (on plain tensors: no autograd graph
+    /// is recorded, even for a network of variables).
     pub fn predict(&self, batch: &GraphBatch) -> Result<Vec<f32>> {
         let graph = GraphInput::from_batch(batch, self.dtype, self.node_encoder.weight.device())?;
         Ok(self.for_inference().forward(&graph)?.to_dtype(DType::F32)?.to_vec1()?)
@@ -313,16 +314,10 @@ impl Mpn {
         Ok((self.node_encoder.forward(&g.node_features)?, self.edge_encoder.forward(&g.edge_features)?))
     }
 
-    /// The decoder MLP and output transform, with the given `tanh` (fused or candle's).
+    /// The decoder MLP, with the given `tanh` (fused or candle's).
     fn decode(&self, x: &Tensor, tanh: impl Fn(&Tensor) -> candle_core::Result<Tensor>) -> Result<Tensor> {
         let [l1, l2, l3] = &self.decoder;
-        let z = l3.forward(&tanh(&l2.forward(&tanh(&l1.forward(x)?)?)?)?)?.squeeze(1)?;
-        Ok(match self.config.output {
-            // relu(z) + log(1 + exp(-|z|)): exact and overflow-free for any z.
-            OutputTransform::Softplus => (z.relu()? + (z.abs()?.neg()?.exp()? + 1.0)?.log()?)?,
-            OutputTransform::None => z,
-            OutputTransform::Exp => z.exp()?,
-        })
+        Ok(l3.forward(&tanh(&l2.forward(&tanh(&l1.forward(x)?)?)?)?)?.squeeze(1)?)
     }
 }
 

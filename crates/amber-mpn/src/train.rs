@@ -1,11 +1,11 @@
 //! Training the network behind plain slices: [`MpnTrainer`] owns the network, its variables and
-//! the Adam optimiser, and takes one step (training-mode forward, mean squared error, backward,
-//! clipping, update) on a [`GraphBatch`] and its targets.
+//! the Adam optimiser, and takes one step (training-mode forward, the objective's mean squared
+//! error, backward, clipping, update) on a [`GraphBatch`] and its targets.
 
 use std::path::Path;
 
 use amber_graph::GraphBatch;
-use amber_nn::Adam;
+use amber_nn::{Adam, Objective};
 use candle_core::{DType, Device, Tensor};
 use candle_nn::VarMap;
 use rand::Rng;
@@ -24,27 +24,28 @@ pub struct StepLoss {
     pub grad_norm: f64,
 }
 
-/// A trainable network (f32, on the CPU) with its variables and optimiser.
+/// A trainable network (f32, on the CPU) with its variables, objective and optimiser.
 pub struct MpnTrainer {
     network: Mpn,
     varmap: VarMap,
+    objective: Objective,
     optimiser: Adam,
 }
 
 impl MpnTrainer {
     /// A freshly initialised network (drawn from `seed`, see [`Mpn::init`]) and fresh moments;
-    /// gradients are clipped to a global norm of `max_grad_norm` if set.
-    pub fn new(config: MpnConfig, seed: u64, max_grad_norm: Option<f64>) -> Result<Self> {
+    /// trained for `objective`; gradients are clipped to a global norm of `max_grad_norm` if set.
+    pub fn new(config: MpnConfig, objective: Objective, seed: u64, max_grad_norm: Option<f64>) -> Result<Self> {
         let (network, varmap) = Mpn::init(config, seed, DType::F32, &Device::Cpu)?;
         let optimiser = Adam::new(&varmap, max_grad_norm)?;
-        Ok(Self { network, varmap, optimiser })
+        Ok(Self { network, varmap, objective, optimiser })
     }
 
     /// The network of a checkpoint written by [`Self::save`], with fresh moments.
-    pub fn load(weights: &Path, max_grad_norm: Option<f64>) -> Result<Self> {
+    pub fn load(weights: &Path, objective: Objective, max_grad_norm: Option<f64>) -> Result<Self> {
         let (network, varmap) = Mpn::load_trainable(weights)?;
         let optimiser = Adam::new(&varmap, max_grad_norm)?;
-        Ok(Self { network, varmap, optimiser })
+        Ok(Self { network, varmap, objective, optimiser })
     }
 
     /// Restores the moments written by [`Self::save_optimiser`] and the count of updates taken.
@@ -63,7 +64,8 @@ impl MpnTrainer {
     }
 
     /// One step on `batch` with one target per node: training-mode forward (edge dropout drawn
-    /// from `rng`), mean squared error, backward, clipping, an Adam update with rate `lr`.
+    /// from `rng`), mean squared error of the objective's activation, backward, clipping, an Adam
+    /// update with rate `lr`.
     pub fn train_step<R: Rng + ?Sized>(
         &mut self,
         batch: &GraphBatch,
@@ -72,7 +74,7 @@ impl MpnTrainer {
         rng: &mut R,
     ) -> Result<StepLoss> {
         let input = GraphInput::from_batch(batch, DType::F32, &Device::Cpu)?;
-        let output = self.network.forward_train(&input, rng)?;
+        let output = self.objective.activation(&self.network.forward_train(&input, rng)?)?;
         // The mean squared error, kept per node for the caller.
         let squared_errors = (output - Tensor::from_slice(targets, batch.num_nodes, &Device::Cpu)?)?.sqr()?;
         let loss = squared_errors.mean_all()?;

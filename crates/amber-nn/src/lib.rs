@@ -4,17 +4,20 @@
 //! the adapter that turns a kernel written as slice loops into a candle custom op ([`op`]), the
 //! parallel reductions whose result does not depend on the thread count, so that training is
 //! bit-reproducible at any number of threads ([`reduce`]), the finiteness check of a loaded
-//! weights file ([`first_non_finite`]), and the finite-difference gradient checker of both
-//! crates' op tests ([`gradcheck`]).
+//! weights file ([`first_non_finite`]), the finite-difference gradient checker of both crates'
+//! op tests ([`gradcheck`]), and the one map between a network's scalar output and an element
+//! size ([`Objective`]).
 //!
-//! This crate depends on candle and rayon only; it knows nothing of meshes, graphs, images or
-//! training loops.
+//! This crate depends on candle, rayon and serde only; it knows nothing of meshes, graphs,
+//! images or training loops.
 
 mod adam;
 mod finite;
 pub mod gradcheck;
+mod objective;
 pub mod op;
 pub mod reduce;
 
 pub use adam::{Adam, clip_grad_norm, grad_norm};
 pub use finite::first_non_finite;
+pub use objective::{Objective, softplus, softplus_inverse};

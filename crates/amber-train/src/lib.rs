@@ -28,21 +28,22 @@ mod config;
 mod error;
 mod method;
 mod model_file;
+mod observer;
 mod rollout;
 
 pub use amber::{
-    Addition, AmberModel, AmberSizing, BufferEntry, CONFIG_FILE, LOG_FILE, MODEL_DIR, NetworkConfig, Objective,
-    Predictor, ReplayBuffer, Sample, SourceSelection, StepReport, TargetTransform, Training, TrainingConfig,
-    TrainingObserver, WEIGHTS_FILE, softplus, softplus_inverse,
+    Addition, AmberModel, AmberSizing, AmberStepReport, BufferEntry, CONFIG_FILE, LOG_FILE, MODEL_DIR, NetworkConfig,
+    Predictor, ReplayBuffer, Sample, SourceSelection, TargetTransform, Training, TrainingConfig, WEIGHTS_FILE,
 };
+pub use amber_nn::Objective;
 pub use checkpoint::{AdditionCounts, CHECKPOINTS_DIR, latest_checkpoint};
 pub use cnn::{
-    CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnConfig, CnnModel, CnnObserver, CnnPredictor, CnnSizing, CnnStepReport,
-    CnnTraining,
+    CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnConfig, CnnModel, CnnPredictor, CnnSizing, CnnStepReport, CnnTraining,
 };
 pub use config::{DataConfig, LrSchedule, Profile};
 pub use error::{Result, TrainError};
 pub use method::{MethodConfig, TrainedModel};
+pub use observer::{StepReport, TrainingObserver};
 pub use rollout::{
     ElementTarget, Evaluation, EvaluationSummary, GeneratedStep, MeshMetrics, PredictedField, Reference, Rollout,
     RolloutStep, SizingModel, StepStatus, StepSummary, fit_final_step_scale, generate, rollouts,

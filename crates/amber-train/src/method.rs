@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Result, TrainError};
 use crate::rollout::{ElementTarget, GeneratedStep, fit_final_step_scale, generate};
 use crate::{
-    AmberModel, CNN_PREDICTOR_FILE, CnnConfig, CnnModel, CnnObserver, CnnTraining, DataConfig, Evaluation, MODEL_DIR,
-    Rollout, Training, TrainingConfig, TrainingObserver,
+    AmberModel, CNN_PREDICTOR_FILE, CnnConfig, CnnModel, CnnTraining, DataConfig, Evaluation, MODEL_DIR, Rollout,
+    Training, TrainingConfig, TrainingObserver,
 };
 
 /// The configuration of one run of either method.
@@ -81,7 +81,7 @@ impl MethodConfig {
     /// configuration and problems must be those of the checkpointed run); AMBER validates on
     /// `val` as configured. Writes the final model to `out_dir/model`. `ready` is told the
     /// training's step and limits once it stands, before the first step.
-    pub fn train<const D: usize, P: Problem<D>, O: TrainingObserver + CnnObserver>(
+    pub fn train<const D: usize, P: Problem<D>, O: TrainingObserver>(
         &self,
         train: Vec<P>,
         val: &[P],

@@ -48,7 +48,7 @@ pub(crate) fn check_moments(field: &str, moments: &RunningMoments, columns: usiz
 
 #[cfg(test)]
 mod tests {
-    use amber_cnn::{CnnLoss, UNet, UNetConfig};
+    use amber_cnn::{UNet, UNetConfig};
     use amber_graph::{FeatureNormaliser, FeatureSet};
     use amber_mpn::{MpnConfig, MpnTrainer};
     use safetensors::SafeTensors;
@@ -74,7 +74,8 @@ mod tests {
             target: TargetTransform::new(Objective::SoftplusResidual, true),
             limits: LIMITS,
         };
-        AmberModel::save(&MpnTrainer::new(network, 0, None).unwrap(), &predictor, dir).unwrap();
+        AmberModel::save(&MpnTrainer::new(network, Objective::SoftplusResidual, 0, None).unwrap(), &predictor, dir)
+            .unwrap();
     }
 
     /// An untrained CNN of two input channels.
@@ -83,7 +84,7 @@ mod tests {
         let predictor = CnnPredictor {
             network: network.clone(),
             resolution: 16,
-            loss: CnnLoss::LogMse,
+            objective: Objective::LogMse,
             normaliser: Some(RunningMoments::new(2)),
             label_moments: Some(RunningMoments::new(1)),
             limits: LIMITS,

@@ -116,7 +116,7 @@ struct KillAfter(u64);
 
 impl TrainingObserver for KillAfter {
     fn step(&mut self, report: &StepReport, _total: u64) {
-        assert!(report.step < self.0, "killed after step {}", report.step);
+        assert!(report.step() < self.0, "killed after step {}", report.step());
     }
 }
 

@@ -1,34 +1,12 @@
 //! Every knob of an AMBER training run ([`TrainingConfig`]) and its named profiles.
 
 use amber_graph::Aggregation;
+use amber_nn::Objective;
 use serde::{Deserialize, Serialize};
 
 use crate::config::{PAPER_LEARNING_RATE, PAPER_MAX_GRAD_NORM};
 use crate::error::{Result, TrainError};
 use crate::{DataConfig, LrSchedule, Profile};
-
-/// What the network's scalar output `z` means and which loss trains it (spec §5, §11).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Objective {
-    /// The paper: size = softplus(z), MSE against the raw label sizes.
-    Softplus,
-    /// size = z, MSE against the raw sizes (the "no softplus" ablation).
-    Linear,
-    /// size = exp(z'), MSE of z against log sizes (the CNN's loss).
-    Log,
-    /// The later version (§11.3): size = softplus(z' + softplus⁻¹(h)), h the current element's
-    /// size; MSE of z against the label's residual softplus⁻¹(y) − softplus⁻¹(h).
-    SoftplusResidual,
-}
-
-impl Objective {
-    /// Whether `z` lives in an unbounded space where label normalisation applies: there `z'` is
-    /// `z` de-normalised with the running label moments.
-    pub fn supports_label_normalisation(self) -> bool {
-        matches!(self, Objective::Log | Objective::SoftplusResidual)
-    }
-}
 
 /// How the source of a new buffer entry is chosen (spec §6, reference notes §6.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -74,8 +52,8 @@ pub struct TrainingConfig {
     pub aggregation: Aggregation,
     /// Output transform and loss.
     pub objective: Objective,
-    /// Normalise the training targets by their running moments (only for objectives with
-    /// unbounded output, see [`Objective::supports_label_normalisation`]).
+    /// Normalise the training targets by their running moments (not for a softplus in the loss,
+    /// see [`Objective::supports_label_normalisation`]).
     pub normalise_labels: bool,
     /// Normalise node and edge features by their running moments (off: the ablation).
     pub normalise_inputs: bool,
@@ -136,7 +114,7 @@ impl TrainingConfig {
             seed: 0,
             data: DataConfig::default(),
             aggregation: Aggregation::Mean,
-            objective: Objective::Softplus,
+            objective: Objective::SoftplusMse,
             normalise_labels: false,
             normalise_inputs: true,
             inputs: Vec::new(),
@@ -237,7 +215,7 @@ impl TrainingConfig {
             return bad("min_size_quantile must be in [0, 1]");
         }
         if self.normalise_labels && !self.objective.supports_label_normalisation() {
-            return bad("normalise_labels needs objective log or softplus_residual");
+            return bad("normalise_labels needs an objective other than softplus_mse");
         }
         if self.network.latent_dim == 0 || !(0.0..1.0).contains(&self.network.edge_dropout) {
             return bad("network.latent_dim must be positive and network.edge_dropout in [0, 1)");
@@ -279,7 +257,8 @@ mod tests {
         let expected = TrainingConfig { steps: 10, aggregation: Aggregation::Max, ..TrainingConfig::quick() };
         assert_eq!(partial, expected, "absent fields are the quick profile's");
         assert!(serde_json::from_str::<TrainingConfig>(r#"{"stepz": 10}"#).is_err());
-        let bad = TrainingConfig { objective: Objective::Softplus, normalise_labels: true, ..TrainingConfig::quick() };
+        let bad =
+            TrainingConfig { objective: Objective::SoftplusMse, normalise_labels: true, ..TrainingConfig::quick() };
         assert!(bad.validate().is_err());
         let huge = TrainingConfig {
             network: NetworkConfig { latent_dim: 1_000_000_000, ..NetworkConfig::default() },

@@ -8,8 +8,8 @@ mod target;
 mod train;
 
 pub use buffer::{BufferEntry, ReplayBuffer, Sample};
-pub use config::{NetworkConfig, Objective, SourceSelection, TrainingConfig};
+pub use config::{NetworkConfig, SourceSelection, TrainingConfig};
 pub(crate) use model::PREDICTOR_FILE;
 pub use model::{AmberModel, AmberSizing, Predictor, WEIGHTS_FILE};
-pub use target::{TargetTransform, softplus, softplus_inverse};
-pub use train::{Addition, CONFIG_FILE, LOG_FILE, MODEL_DIR, StepReport, Training, TrainingObserver};
+pub use target::TargetTransform;
+pub use train::{Addition, AmberStepReport, CONFIG_FILE, LOG_FILE, MODEL_DIR, Training};

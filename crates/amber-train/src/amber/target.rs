@@ -1,21 +1,9 @@
-//! The map between element sizes and what the network regresses: training targets from labels,
-//! sizes from network outputs, with the optional running normalisation of the targets.
+//! The map between element sizes and what the network regresses: the objective's targets and
+//! sizes (`amber_nn::Objective`), with the optional running normalisation of the targets.
 
 use amber_graph::RunningMoments;
-use amber_mpn::OutputTransform;
+use amber_nn::Objective;
 use serde::{Deserialize, Serialize};
-
-use crate::Objective;
-
-/// softplus(x) = log(1 + eˣ), overflow-free.
-pub fn softplus(x: f64) -> f64 {
-    x.max(0.0) + (-x.abs()).exp().ln_1p()
-}
-
-/// softplus⁻¹(y) = y + log(1 − e⁻ʸ) for y > 0.
-pub fn softplus_inverse(y: f64) -> f64 {
-    y + (-(-y).exp_m1()).ln()
-}
 
 /// The objective plus the running moments of its targets (when labels are normalised).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -33,24 +21,9 @@ impl TargetTransform {
         Self { objective, moments: normalise.then(|| RunningMoments::new(1)) }
     }
 
-    /// The output transform the network itself applies.
-    pub fn network_output(&self) -> OutputTransform {
-        match self.objective {
-            Objective::Softplus => OutputTransform::Softplus,
-            Objective::Linear | Objective::Log | Objective::SoftplusResidual => OutputTransform::None,
-        }
-    }
-
-    /// Un-normalised targets of one graph: labels y, log y, or softplus⁻¹(y) − softplus⁻¹(h)
-    /// for the current element sizes h.
+    /// Un-normalised targets of one graph ([`Objective::target`]) for the current element sizes.
     pub fn raw_targets(&self, labels: &[f64], current_sizes: &[f64]) -> Vec<f64> {
-        match self.objective {
-            Objective::Softplus | Objective::Linear => labels.to_vec(),
-            Objective::Log => labels.iter().map(|y| y.ln()).collect(),
-            Objective::SoftplusResidual => {
-                labels.iter().zip(current_sizes).map(|(&y, &h)| softplus_inverse(y) - softplus_inverse(h)).collect()
-            }
-        }
+        labels.iter().zip(current_sizes).map(|(&y, &h)| self.objective.target(y, Some(h))).collect()
     }
 
     /// Merges one graph's raw targets into the running moments (a no-op without normalisation).
@@ -77,38 +50,30 @@ impl TargetTransform {
             Some(m) => (m.mean()[0], (m.variance()[0] + amber_graph::VARIANCE_EPSILON).sqrt()),
             None => (0.0, 1.0),
         };
-        let denormalised = z.iter().map(|&z| f64::from(z) * scale + shift);
-        match self.objective {
-            // The network already applied softplus, or nothing.
-            Objective::Softplus | Objective::Linear => denormalised.collect(),
-            Objective::Log => denormalised.map(f64::exp).collect(),
-            Objective::SoftplusResidual => {
-                denormalised.zip(current_sizes).map(|(r, &h)| softplus(r + softplus_inverse(h))).collect()
-            }
-        }
+        z.iter().zip(current_sizes).map(|(&z, &h)| self.objective.size(f64::from(z) * scale + shift, Some(h))).collect()
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use amber_nn::softplus_inverse;
+
     use super::*;
 
     #[test]
-    fn softplus_inverse_inverts_softplus_over_the_size_range() {
-        for y in [1e-6, 1e-3, 0.05, 0.9, 3.0, 40.0] {
-            assert!((softplus(softplus_inverse(y)) - y).abs() <= 1e-12 * y.max(1.0), "{y}");
-        }
-    }
-
-    #[test]
-    fn perfect_targets_map_back_to_the_labels() {
+    fn perfect_outputs_map_back_to_the_labels() {
         let labels = [0.01, 0.2, 0.5];
         let current = [0.9, 0.1, 0.5];
-        for objective in [Objective::Softplus, Objective::Linear, Objective::Log, Objective::SoftplusResidual] {
+        for objective in [Objective::SoftplusMse, Objective::Mse, Objective::LogMse, Objective::SoftplusResidual] {
             let mut t = TargetTransform::new(objective, true);
             let raw = t.raw_targets(&labels, &current);
             t.update(&raw);
-            let z = t.training_targets(&raw);
+            // The outputs whose activation is the training target.
+            let z: Vec<f32> = t
+                .training_targets(&raw)
+                .into_iter()
+                .map(|z| if objective == Objective::SoftplusMse { softplus_inverse(f64::from(z)) as f32 } else { z })
+                .collect();
             let sizes = t.sizes(&z, &current);
             for (s, y) in sizes.iter().zip(labels) {
                 assert!((s - y).abs() < 1e-5 * y.max(0.1), "{objective:?}: {s} vs {y}");

@@ -23,8 +23,8 @@ use crate::checkpoint::{
 };
 use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::{
-    AmberModel, AmberSizing, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, TargetTransform,
-    TrainingConfig, fit_final_step_scale,
+    AmberModel, AmberSizing, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, StepReport,
+    TargetTransform, TrainingConfig, TrainingObserver, fit_final_step_scale,
 };
 
 /// The final model's sub-directory of the output directory.
@@ -48,7 +48,7 @@ pub enum Addition {
 
 /// One gradient step (and the addition that followed it, if one was due).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct StepReport {
+pub struct AmberStepReport {
     /// Gradient steps completed, this one included.
     pub step: u64,
     /// Loss of the batch (in the objective's training space).
@@ -70,20 +70,6 @@ pub struct StepReport {
     /// Buffer entries per depth (index = depth).
     pub buffer_depths: Vec<usize>,
 }
-
-/// Progress callbacks of [`Training::run`] (binaries draw bars with them; the library never
-/// prints). Every method has an empty default.
-pub trait TrainingObserver {
-    /// After every gradient step.
-    fn step(&mut self, _report: &StepReport, _total_steps: u64) {}
-    /// After every validation rollout.
-    fn validation(&mut self, _step: u64, _summary: &EvaluationSummary) {}
-    /// After every checkpoint.
-    fn checkpoint(&mut self, _step: u64, _dir: &Path) {}
-}
-
-/// Observes nothing.
-impl TrainingObserver for () {}
 
 /// A training run: network, optimiser, buffer, normalisers and generators.
 pub struct Training<const D: usize, P: Problem<D>> {
@@ -129,10 +115,9 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             latent_dim: config.network.latent_dim,
             steps: config.network.message_passing_steps,
             edge_dropout: config.network.edge_dropout,
-            output: target.network_output(),
             graph_context: config.network.graph_context,
         };
-        let trainer = MpnTrainer::new(network_config, config.seed, config.max_grad_norm)?;
+        let trainer = MpnTrainer::new(network_config, config.objective, config.seed, config.max_grad_norm)?;
         let mut training = Self {
             buffer: ReplayBuffer::new(config.buffer_capacity),
             dropout_rng: seeded_stream(config.seed, 1),
@@ -177,7 +162,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             return Err(fail("the training problems differ from the checkpointed run's".into()));
         }
         state.check(problems.len()).map_err(fail)?;
-        let mut trainer = MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.max_grad_norm)?;
+        let mut trainer = MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.objective, config.max_grad_norm)?;
         let predictor = Predictor::read(&dir.join(super::model::PREDICTOR_FILE), trainer.network().config())?;
         trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
@@ -260,7 +245,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
     }
 
     /// One gradient step on the next least-used batch, then a buffer addition if one is due.
-    pub fn train_step(&mut self) -> Result<StepReport> {
+    pub fn train_step(&mut self) -> Result<AmberStepReport> {
         let started = Instant::now();
         let lr = self.config.lr_schedule.rate(self.config.learning_rate, self.step, self.config.steps);
         let chosen = self.buffer.next_batch(self.config.batch_nodes);
@@ -279,7 +264,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let addition =
             if self.step.is_multiple_of(self.config.add_interval) { Some(self.add_generated()?) } else { None };
         self.step += 1;
-        Ok(StepReport {
+        Ok(AmberStepReport {
             step: self.step,
             loss: step.loss,
             loss_by_depth,
@@ -343,7 +328,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         while self.step < total {
             let report = self.train_step()?;
             log.write(&LogRecord::Step(&report))?;
-            observer.step(&report, total);
+            observer.step(&StepReport::Amber(report), total);
             let (step, last) = (self.step, self.step == total);
             let interval = self.config.validation_interval;
             if let Some(validation) = validation
@@ -407,7 +392,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
 #[derive(Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 enum LogRecord<'a> {
-    Step(&'a StepReport),
+    Step(&'a AmberStepReport),
     Validation { step: u64, summary: &'a EvaluationSummary },
 }
 

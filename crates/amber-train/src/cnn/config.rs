@@ -1,7 +1,8 @@
 //! Every knob of a CNN training run ([`CnnConfig`]) and its named profiles.
 
-use amber_cnn::{CnnLoss, UNetConfig};
+use amber_cnn::UNetConfig;
 use amber_graph::Aggregation;
+use amber_nn::Objective;
 use serde::{Deserialize, Serialize};
 
 use crate::config::{PAPER_LEARNING_RATE, PAPER_MAX_GRAD_NORM};
@@ -20,8 +21,10 @@ pub struct CnnConfig {
     pub resolution: usize,
     /// Channels of the U-Net's first level (the paper's runs 64, its text 32).
     pub initial_channels: usize,
-    /// Output transform and loss.
-    pub loss: CnnLoss,
+    /// Output transform and loss (`loss` in the JSON); not `softplus_residual`, which needs a
+    /// current mesh.
+    #[serde(rename = "loss")]
+    pub objective: Objective,
     /// Mean or max projection of the expert onto the auxiliary mesh.
     pub aggregation: Aggregation,
     /// Gradient steps.
@@ -62,7 +65,7 @@ impl CnnConfig {
             data: DataConfig::default(),
             resolution: 256,
             initial_channels: 64,
-            loss: CnnLoss::LogMse,
+            objective: Objective::LogMse,
             aggregation: Aggregation::Mean,
             steps: 25_600,
             learning_rate: PAPER_LEARNING_RATE,
@@ -144,7 +147,10 @@ impl CnnConfig {
         if !(0.0..=1.0).contains(&self.min_size_quantile) {
             return bad("min_size_quantile must be in [0, 1]");
         }
-        if self.normalise_labels && self.loss == CnnLoss::SoftplusMse {
+        if self.objective.needs_current_size() {
+            return bad("loss softplus_residual needs a current mesh; the CNN predicts from the geometry alone");
+        }
+        if self.normalise_labels && !self.objective.supports_label_normalisation() {
             return bad("normalise_labels needs loss log_mse or mse");
         }
         // Upper bounds that a machine can hold, so that a typo is an error, not an abort.
@@ -168,11 +174,14 @@ mod tests {
             assert_eq!(serde_json::from_str::<CnnConfig>(&json).unwrap(), config);
         }
         let partial: CnnConfig = serde_json::from_str(r#"{"resolution": 64, "loss": "softplus_mse"}"#).unwrap();
-        assert_eq!(partial, CnnConfig { resolution: 64, loss: CnnLoss::SoftplusMse, ..CnnConfig::quick() });
+        assert_eq!(partial, CnnConfig { resolution: 64, objective: Objective::SoftplusMse, ..CnnConfig::quick() });
         assert!(CnnConfig { resolution: 40, ..CnnConfig::quick() }.validate().is_err());
         assert!(CnnConfig { images_per_step: Some(0), ..CnnConfig::quick() }.validate().is_err());
         assert!(
-            CnnConfig { loss: CnnLoss::SoftplusMse, normalise_labels: true, ..CnnConfig::quick() }.validate().is_err()
+            CnnConfig { objective: Objective::SoftplusMse, normalise_labels: true, ..CnnConfig::quick() }
+                .validate()
+                .is_err()
         );
+        assert!(CnnConfig { objective: Objective::SoftplusResidual, ..CnnConfig::quick() }.validate().is_err());
     }
 }

@@ -7,4 +7,4 @@ mod train;
 
 pub use config::CnnConfig;
 pub use model::{CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnModel, CnnPredictor, CnnSizing};
-pub use train::{CnnObserver, CnnStepReport, CnnTraining};
+pub use train::{CnnStepReport, CnnTraining};

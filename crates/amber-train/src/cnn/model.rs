@@ -3,10 +3,11 @@
 
 use std::path::Path;
 
-use amber_cnn::{CnnLoss, PixelGrid, Raster, UNet, UNetConfig};
+use amber_cnn::{PixelGrid, Raster, UNet, UNetConfig};
 use amber_graph::{GraphError, NodeFeature, RunningMoments, VARIANCE_EPSILON};
 use amber_mesh::Mesh;
 use amber_meshgen::SizingField;
+use amber_nn::Objective;
 use amber_stdx::write_json_atomic;
 use amber_tasks::{Domain, MeshLimits};
 use rayon::prelude::*;
@@ -27,7 +28,9 @@ pub struct CnnPredictor {
     pub network: UNetConfig,
     /// Pixels per axis.
     pub resolution: usize,
-    pub loss: CnnLoss,
+    /// `loss` in the JSON, as in [`crate::CnnConfig`].
+    #[serde(rename = "loss")]
+    pub objective: Objective,
     /// Moments of the input channels over the training pixels; `None`: inputs are fed raw.
     pub normaliser: Option<RunningMoments>,
     /// Moments of the targets over the inside training pixels; `None`: the network regresses
@@ -106,12 +109,16 @@ impl CnnPredictor {
     }
 
     /// Checks what a file could get wrong: the network's configuration, a positive resolution,
-    /// the input and label moments (finite, non-negative variances, positive counts, one column
-    /// per input channel or one label) and the limits (positive).
+    /// an objective that needs no current mesh, the input and label moments (finite,
+    /// non-negative variances, positive counts, one column per input channel or one label) and
+    /// the limits (positive).
     fn validate(&self) -> Result<(), String> {
         self.network.validate().map_err(|e| format!("network: {e}"))?;
         if self.resolution == 0 {
             return Err("resolution is 0".into());
+        }
+        if self.objective.needs_current_size() {
+            return Err("loss softplus_residual needs a current mesh".into());
         }
         if let Some(moments) = &self.normaliser {
             check_moments("normaliser", moments, self.network.in_channels)?;
@@ -150,7 +157,8 @@ impl CnnPredictor {
             Some(m) => ((m.variance()[0] + VARIANCE_EPSILON).sqrt(), m.mean()[0]),
             None => (1.0, 0.0),
         };
-        let mut sizes: Vec<f64> = z.into_iter().map(|z| self.loss.size(f64::from(z) * scale + shift)).collect();
+        let mut sizes: Vec<f64> =
+            z.into_iter().map(|z| self.objective.size(f64::from(z) * scale + shift, None)).collect();
         sample.raster.fill_outside(&mut sizes)?;
         let field = sample.raster.grid.sizing(sizes);
         Ok(sample.auxiliary.midpoints().into_iter().map(|x| field.size_at(x)).collect())

@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use super::model::{CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnModel, CnnPredictor, Rasterised, rasterise, transpose};
 use crate::checkpoint::{self, OPTIMISER_FILE, ProblemFingerprint, RngState, STATE_FILE, fingerprints, seeded_stream};
 use crate::error::{Result, TrainError, in_problem, io_error};
-use crate::{BufferEntry, CnnConfig};
+use crate::{BufferEntry, CnnConfig, StepReport, TrainingObserver};
 
 /// One gradient step of a CNN run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -38,18 +38,6 @@ pub struct CnnStepReport {
     /// Wall time of the step.
     pub seconds: f64,
 }
-
-/// Progress callbacks of [`CnnTraining::run`] (the library never prints). Every method has an
-/// empty default.
-pub trait CnnObserver {
-    /// After every gradient step.
-    fn step(&mut self, _report: &CnnStepReport, _total_steps: u64) {}
-    /// After every checkpoint.
-    fn checkpoint(&mut self, _step: u64, _dir: &Path) {}
-}
-
-/// Observes nothing.
-impl CnnObserver for () {}
 
 /// `state.json` of a CNN checkpoint.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -114,7 +102,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         let inside_targets: Vec<f32> = samples
             .iter()
             .flat_map(|(sample, labels)| {
-                sample.raster.owners.iter().flatten().map(|&e| config.loss.target(labels[e as usize]) as f32)
+                sample.raster.owners.iter().flatten().map(|&e| config.objective.target(labels[e as usize], None) as f32)
             })
             .collect();
         let label_moments = config
@@ -128,7 +116,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         let predictor = CnnPredictor {
             network: config.network::<D>(channels),
             resolution: config.resolution,
-            loss: config.loss,
+            objective: config.objective,
             normaliser,
             label_moments,
             limits,
@@ -159,7 +147,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
     pub fn new(config: CnnConfig, problems: Vec<P>) -> Result<Self> {
         let (network, predictor, images) =
             Self::prepare(&config, &problems, |p| Ok(UNet::init(p.network.clone(), config.seed)?))?;
-        let trainer = CnnTrainer::new(network, images, config.loss, config.max_grad_norm)?;
+        let trainer = CnnTrainer::new(network, images, config.objective, config.max_grad_norm)?;
         Ok(Self { subset_rng: seeded_stream(config.seed, 3), config, problems, trainer, predictor, step: 0 })
     }
 
@@ -188,7 +176,7 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
         if saved != predictor {
             return Err(fail("the rasterised problems give another normaliser or limits than the checkpointed run's"));
         }
-        let mut trainer = CnnTrainer::new(network, images, config.loss, config.max_grad_norm)?;
+        let mut trainer = CnnTrainer::new(network, images, config.objective, config.max_grad_norm)?;
         trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         Ok(Self { subset_rng: state.subset_rng.restore(dir)?, config, problems, trainer, predictor, step: state.step })
     }
@@ -244,12 +232,12 @@ impl<const D: usize, P: Problem<D>> CnnTraining<D, P> {
     /// Trains until `config.steps` from wherever the run stands, checkpoints every
     /// `checkpoint_interval` steps and at the end, and writes the final model to
     /// `out_dir/model`, which it returns.
-    pub fn run(&mut self, out_dir: &Path, observer: &mut dyn CnnObserver) -> Result<PathBuf> {
+    pub fn run(&mut self, out_dir: &Path, observer: &mut dyn TrainingObserver) -> Result<PathBuf> {
         std::fs::create_dir_all(out_dir).map_err(io_error(out_dir))?;
         write_json_atomic(&out_dir.join(crate::CONFIG_FILE), &self.config)?;
         while self.step < self.config.steps {
             let report = self.train_step()?;
-            observer.step(&report, self.config.steps);
+            observer.step(&StepReport::Cnn(report), self.config.steps);
             if self.step.is_multiple_of(self.config.checkpoint_interval) || self.step == self.config.steps {
                 let dir = self.save_checkpoint(out_dir)?;
                 observer.checkpoint(self.step, &dir);
