@@ -317,6 +317,57 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     assert!(!output.status.success() && stderr.contains("val") && !stderr.contains("panicked"), "{stderr}");
 }
 
+/// Parts' own inputs (`<stem>.inputs.json`) train into a model that names them; meshing a new part
+/// with that model needs them (`--problem`), and without them the error says so.
+#[test]
+fn a_model_of_parts_with_inputs_meshes_a_part_given_its_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("plates");
+    amber_tasks::folder::write_demo_dataset(&data, 2).unwrap();
+    for split in ["train", "val", "test"] {
+        for entry in std::fs::read_dir(data.join(split)).unwrap() {
+            let mesh = entry.unwrap().path();
+            let stem = mesh.file_stem().unwrap().to_str().unwrap().to_owned();
+            let inputs = r#"{"clamp": [0.0, 0.5], "load": 2.0}"#;
+            std::fs::write(data.join(split).join(format!("{stem}.inputs.json")), inputs).unwrap();
+        }
+    }
+    let config = dir.path().join("config.json");
+    std::fs::write(
+        &config,
+        r#"{"checkpoint_interval": 10, "validation_interval": 0, "inference_steps": 2,
+            "network": {"latent_dim": 8, "message_passing_steps": 2},
+            "inputs": ["log_size", "log_boundary_distance", "load", "log_distance_to_clamp"]}"#,
+    )
+    .unwrap();
+    let run = dir.path().join("run");
+    let output = amber()
+        .args(["train", "--profile", "smoke", "--steps", "10", "--data"])
+        .arg(&data)
+        .arg("--config")
+        .arg(&config)
+        .arg("--out")
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+
+    let plate = data.join("test/plate00.msh");
+    let mesh = || {
+        let mut command = amber();
+        command.arg("mesh").arg(&plate).arg("--model").arg(&run).arg("-o").arg(dir.path().join("p.vtu"));
+        command
+    };
+    let output = mesh().output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && stderr.contains("load, log_distance_to_clamp") && stderr.contains("--problem"),
+        "{stderr}"
+    );
+    let output = mesh().arg("--problem").arg(data.join("test/plate00.inputs.json")).output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+}
+
 /// Every model shipped in `models/` loads and meshes a geometry of its task from the geometry
 /// alone (a Poisson model with a load, no expert); reads `../shared/` for the Console surface.
 #[test]
