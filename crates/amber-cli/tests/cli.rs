@@ -209,6 +209,18 @@ fn evaluate(model: &std::path::Path, data: &std::path::Path, out: &std::path::Pa
     serde_json::from_str(&std::fs::read_to_string(out.join("evaluation.json")).unwrap()).unwrap()
 }
 
+/// `amber train --profile smoke --steps STEPS --data DATA --config CONFIG --out RUN`.
+fn train_smoke_folder(
+    data: &std::path::Path,
+    config: &std::path::Path,
+    run: impl AsRef<std::ffi::OsStr>,
+    steps: u64,
+) -> std::process::Output {
+    let mut command = amber();
+    command.args(["train", "--profile", "smoke", "--steps", &steps.to_string()]);
+    command.arg("--data").arg(data).arg("--config").arg(config).arg("--out").arg(run).output().unwrap()
+}
+
 /// A folder dataset end to end: the project's demo plates (2D `.msh` experts, no geometry files)
 /// train a tiny model, which is evaluated on the test split (JSON, Markdown, a picture per part)
 /// and meshes one of its plates from the plate's boundary alone.
@@ -225,15 +237,7 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     )
     .unwrap();
     let run = dir.path().join("run");
-    let output = amber()
-        .args(["train", "--profile", "smoke", "--steps", "30", "--data"])
-        .arg(&data)
-        .arg("--config")
-        .arg(&config)
-        .arg("--out")
-        .arg(&run)
-        .output()
-        .unwrap();
+    let output = train_smoke_folder(&data, &config, &run, 30);
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     let card: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(run.join("model/card.json")).unwrap()).unwrap();
@@ -304,15 +308,7 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
 
     // A folder with a split missing is an error naming it, not a panic.
     std::fs::remove_dir_all(data.join("val")).unwrap();
-    let output = amber()
-        .args(["train", "--profile", "smoke", "--steps", "30", "--data"])
-        .arg(&data)
-        .arg("--config")
-        .arg(&config)
-        .arg("--out")
-        .arg(dir.path().join("run2"))
-        .output()
-        .unwrap();
+    let output = train_smoke_folder(&data, &config, dir.path().join("run2"), 30);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success() && stderr.contains("val") && !stderr.contains("panicked"), "{stderr}");
 }
@@ -341,15 +337,7 @@ fn a_model_of_parts_with_inputs_meshes_a_part_given_its_inputs() {
     )
     .unwrap();
     let run = dir.path().join("run");
-    let output = amber()
-        .args(["train", "--profile", "smoke", "--steps", "10", "--data"])
-        .arg(&data)
-        .arg("--config")
-        .arg(&config)
-        .arg("--out")
-        .arg(&run)
-        .output()
-        .unwrap();
+    let output = train_smoke_folder(&data, &config, &run, 10);
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
 
     let plate = data.join("test/plate00.msh");
