@@ -203,6 +203,8 @@ pub struct SolidPart {
     /// The part's own inputs (none unless given).
     pub inputs: PartInputs<3>,
     distance: SurfaceDistance,
+    /// The diagonal of the surface's bounding box.
+    extent: f64,
 }
 
 impl SolidPart {
@@ -212,7 +214,8 @@ impl SolidPart {
         let params = Mesh3dParams { curvature_tolerance: f64::INFINITY, size_factor: 1.0, ..Mesh3dParams::default() };
         let initial_mesh = generate_3d(&surface, &ConstantSize(initial_size), &params)?;
         let distance = SurfaceDistance::new(&surface);
-        Ok(Self { name, surface, initial_mesh, inputs: PartInputs::default(), distance })
+        let extent = amber_mesh::bounding_box(surface.vertices()).map_or(1.0, diagonal);
+        Ok(Self { name, surface, initial_mesh, inputs: PartInputs::default(), distance, extent })
     }
 }
 
@@ -233,8 +236,7 @@ impl Domain<3> for SolidPart {
     /// The [`GEOMETRY_INPUTS`] and the part's inputs; the feature set's own features are
     /// computed by the graph.
     fn columns(&self, mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
-        let extent = amber_mesh::bounding_box(self.surface.vertices()).map_or(1.0, diagonal);
-        let (midpoints, distance) = (mesh.midpoints(), &self.distance);
+        let (midpoints, distance, extent) = (mesh.midpoints(), &self.distance, self.extent);
         let mut columns =
             geometry_columns(&midpoints, extent, |p| distance.to_surface(p), |p| distance.to_feature_curve(p));
         columns.extend(self.inputs.columns(&midpoints, extent));
@@ -260,6 +262,8 @@ pub struct PlanarPart {
     /// The part's own inputs (none unless given).
     pub inputs: PartInputs<2>,
     distance: PolygonDistance,
+    /// The diagonal of the domain's bounding box.
+    extent: f64,
 }
 
 impl PlanarPart {
@@ -267,7 +271,8 @@ impl PlanarPart {
     pub fn new(name: String, domain: PolygonDomain, initial_size: f64) -> Result<Self, MeshgenError> {
         let initial_mesh = uniform_mesh_2d(&domain, initial_size, &Mesh2dParams::default())?;
         let distance = PolygonDistance::new(&domain);
-        Ok(Self { name, domain, initial_mesh, inputs: PartInputs::default(), distance })
+        let extent = diagonal(domain.bounding_box());
+        Ok(Self { name, domain, initial_mesh, inputs: PartInputs::default(), distance, extent })
     }
 }
 
@@ -288,8 +293,7 @@ impl Domain<2> for PlanarPart {
     /// The [`GEOMETRY_INPUTS`] and the part's inputs; the feature set's own features are
     /// computed by the graph.
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-        let extent = diagonal(self.domain.bounding_box());
-        let (midpoints, distance) = (mesh.midpoints(), &self.distance);
+        let (midpoints, distance, extent) = (mesh.midpoints(), &self.distance, self.extent);
         let mut columns = geometry_columns(&midpoints, extent, |p| distance.to_boundary(p), |p| distance.to_corner(p));
         columns.extend(self.inputs.columns(&midpoints, extent));
         Ok(columns)
