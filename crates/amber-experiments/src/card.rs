@@ -10,6 +10,7 @@ use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
 use crate::Task;
+use crate::results::RunResult;
 
 /// The card's file inside a model directory.
 pub const CARD_FILE: &str = "card.json";
@@ -49,6 +50,19 @@ pub struct CardEvaluation {
     /// Mean elements of the final meshes and of the experts'.
     pub elements: f64,
     pub expert_elements: f64,
+}
+
+impl CardEvaluation {
+    /// The scores of a run's row on the problems named `problems`.
+    pub fn of(problems: &str, result: &RunResult) -> Self {
+        Self {
+            problems: problems.to_owned(),
+            normalised_dcd: result.ndcd,
+            normalised_dcd_per_step: result.ndcd_per_step.clone(),
+            elements: result.elements,
+            expert_elements: result.expert_elements,
+        }
+    }
 }
 
 impl ModelCard {

@@ -21,7 +21,7 @@ use crate::method::{Method, MethodSpec};
 use crate::outputs::{Setting, gallery_rows, write_outputs};
 use crate::profiles::{Overrides, Task, run_config};
 use crate::results::ExperimentResults;
-use crate::run::{CachedEvaluation, GALLERY_PROBLEMS, Run, evaluation_name, train_run};
+use crate::run::{CachedEvaluation, GALLERY_PROBLEMS, Run, RunOrigin, evaluation_name, train_run};
 
 /// The two viewpoints of the galleries.
 const VIEWS: [View; 2] =
@@ -145,11 +145,17 @@ impl ConsoleExperiment {
         let data = serde_json::json!({
             "dir": self.data, "train_set": self.train_set, "initial_mesh": INITIAL_MESH_RECIPE,
         });
+        let parts = self.train_set.part_limit().map_or("all".to_owned(), |n| format!("the first {n}"));
+        let origin = RunOrigin {
+            task: Task::Console,
+            initial_size: INITIAL_SIZE,
+            data: format!("{parts} Console training parts of {}", self.data.display()),
+        };
         let mut runs = Vec::new();
         for seed in 0..self.seeds {
             for spec in &self.methods {
                 let config = self.run_config(spec, seed)?;
-                let run = Run::new(&self.runs_root, "console", "console", spec, &config, data.clone(), &test_name);
+                let run = Run::new(&self.runs_root, &origin, "console", spec, &config, data.clone(), &test_name);
                 runs.push(GridRun { spec: spec.clone(), seed, config, run });
             }
         }

@@ -10,7 +10,7 @@ use amber_plot::{Tile, TileMesh, mesh_gallery};
 use amber_stdx::read_json;
 use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
-use amber_tasks::poisson::{Difficulty, PoissonProblem, Split, load_split, read_split};
+use amber_tasks::poisson::{Difficulty, INITIAL_SIZE, PoissonProblem, Split, load_split, read_split};
 use amber_train::{MethodConfig, Profile};
 use anyhow::bail;
 use serde::Serialize;
@@ -22,7 +22,7 @@ use crate::profiles::{Overrides, Task, amber_config, run_config};
 use crate::progress::item_bar;
 use crate::report::merge_json;
 use crate::results::ExperimentResults;
-use crate::run::{CachedEvaluation, GALLERY_PROBLEMS, Run, evaluation_name, train_run};
+use crate::run::{CachedEvaluation, GALLERY_PROBLEMS, Run, RunOrigin, evaluation_name, train_run};
 
 /// Everything an invocation of the Poisson experiment decides.
 #[derive(Clone, Debug, Serialize)]
@@ -239,19 +239,21 @@ impl PoissonExperiment {
             let (test, test_name) = self.test_problems(difficulty)?;
             let test_name = evaluation_name(test_name, self.scale_to_budget);
             let data = serde_json::json!({ "manifest": manifest, "difficulty": difficulty });
+            let origin = RunOrigin {
+                task: Task::Poisson,
+                initial_size: INITIAL_SIZE,
+                data: format!(
+                    "{difficulty} training problems of {} under {}",
+                    self.manifest.display(),
+                    self.data_root.display()
+                ),
+            };
             let mut runs = Vec::new();
             for seed in 0..self.seeds {
                 for spec in &self.methods {
                     let config = self.run_config(spec, seed)?;
-                    let run = Run::new(
-                        &self.runs_root,
-                        "poisson",
-                        difficulty.name(),
-                        spec,
-                        &config,
-                        data.clone(),
-                        &test_name,
-                    );
+                    let run =
+                        Run::new(&self.runs_root, &origin, difficulty.name(), spec, &config, data.clone(), &test_name);
                     runs.push(GridRun { spec: spec.clone(), seed, config, run });
                 }
             }

@@ -26,6 +26,15 @@ pub enum Task {
 }
 
 impl Task {
+    /// The task's name: the first level of its runs' directories.
+    pub fn name(self) -> &'static str {
+        match self {
+            Task::Poisson => "poisson",
+            Task::Console => "console",
+            Task::Folder { .. } => "folder",
+        }
+    }
+
     /// The dimension of the task's meshes.
     pub fn dimension(self) -> usize {
         match self {

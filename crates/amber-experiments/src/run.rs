@@ -16,9 +16,11 @@ use amber_train::{
 use anyhow::{Context, bail};
 use serde::{Deserialize, Serialize};
 
+use crate::card::{CardEvaluation, ModelCard};
 use crate::method::MethodSpec;
+use crate::profiles::Task;
 use crate::progress::TrainingProgress;
-use crate::report::{config_hash, write_json};
+use crate::report::{commit, config_hash, write_json};
 use crate::results::{ProblemEvaluation, RunKey, RunResult};
 
 /// Test problems whose rollouts are kept as meshes (`.vtu`) and drawn in the gallery.
@@ -57,6 +59,15 @@ impl CachedEvaluation {
     }
 }
 
+/// What the model card of an experiment's runs says about their task and data.
+pub(crate) struct RunOrigin {
+    pub task: Task,
+    /// Edge length of M⁰.
+    pub initial_size: f64,
+    /// The training data, for people.
+    pub data: String,
+}
+
 /// A run directory: `<runs>/<task>/<setting>/<method>[-<variant>]/seed<r>-<hash>`, where the
 /// hash covers the config and `data` (what identifies the training data).
 pub(crate) struct Run {
@@ -66,12 +77,14 @@ pub(crate) struct Run {
     pub label: String,
     test_name: String,
     eval_dir: PathBuf,
+    /// The model's card, short of what training and evaluation fill in.
+    card: ModelCard,
 }
 
 impl Run {
     pub fn new(
         runs_root: &Path,
-        task: &str,
+        origin: &RunOrigin,
         setting: &str,
         spec: &MethodSpec,
         config: &MethodConfig,
@@ -83,12 +96,23 @@ impl Run {
             variant => format!("{}-{variant}", spec.method.name()),
         };
         let hashed = serde_json::json!({ "config": config.to_json(), "data": data });
-        let key = format!("{task}/{setting}/{name}/seed{}-{}", config.seed(), config_hash(&hashed));
+        let key = format!("{}/{setting}/{name}/seed{}-{}", origin.task.name(), config.seed(), config_hash(&hashed));
         let dir = runs_root.join(&key);
         // Evaluations are keyed by the test set and how it is evaluated.
         let eval_dir = dir.join(format!("eval-{}", config_hash(&serde_json::json!(test_name))));
         let label = format!("{} {setting} seed {}", spec.label(), config.seed());
-        Self { key, dir, label, test_name: test_name.into(), eval_dir }
+        let card = ModelCard {
+            task: origin.task,
+            method: name,
+            inference_steps: config.inference_steps(),
+            initial_size: origin.initial_size,
+            command: String::new(),
+            data: format!("{}, seed {}", origin.data, config.seed()),
+            commit: String::new(),
+            training_seconds: 0.0,
+            evaluation: None,
+        };
+        Self { key, dir, label, test_name: test_name.into(), eval_dir, card }
     }
 
     fn evaluation_path(&self) -> PathBuf {
@@ -124,6 +148,7 @@ impl Run {
         if cache.exists() {
             let cached: CachedEvaluation = read_json(&cache)?;
             println!("{}: reusing the evaluation in {}", self.label, cache.display());
+            self.write_card(&cached)?;
             return Ok(cached);
         }
         let train_seconds = train(&self.dir, &self.label)?;
@@ -147,7 +172,37 @@ impl Run {
         );
         let evaluated = CachedEvaluation { test_set: self.test_name.clone(), train_seconds, eval_seconds, problems };
         write_json(&cache, &evaluated)?;
+        self.write_card(&evaluated)?;
         Ok(evaluated)
+    }
+
+    /// Writes the model's card, with the command and commit that trained it and its scores on
+    /// the test set, so that `amber mesh` and `amber evaluate` take the run's model as they take
+    /// a shipped one.
+    fn write_card(&self, evaluated: &CachedEvaluation) -> anyhow::Result<()> {
+        let model = self.dir.join(MODEL_DIR);
+        if !model.is_dir() {
+            return Ok(());
+        }
+        let record_path = self.dir.join(TIME_FILE);
+        let record: TrainingRecord = if record_path.exists() { read_json(&record_path)? } else { Default::default() };
+        let key = RunKey {
+            method: &self.card.method,
+            variant: "",
+            difficulty: "",
+            seed: 0,
+            train_seconds: evaluated.train_seconds,
+            eval_seconds: evaluated.eval_seconds,
+        };
+        let result = RunResult::new(key, &evaluated.problems);
+        let card = ModelCard {
+            command: record.command.unwrap_or_else(|| "unknown (trained before runs recorded it)".into()),
+            commit: record.commit.unwrap_or_else(|| "unknown (trained before runs recorded it)".into()),
+            training_seconds: evaluated.train_seconds,
+            evaluation: Some(CardEvaluation::of(&evaluated.test_set, &result)),
+            ..self.card.clone()
+        };
+        card.write(&model)
     }
 
     fn gallery_path(&self, problem: usize, step: usize) -> PathBuf {
@@ -213,18 +268,35 @@ pub fn train_run<const D: usize, P: Problem<D>>(
     progress.finish()
 }
 
-/// Training wall time, accumulated over resumed sessions.
+/// Training wall time, accumulated over resumed sessions, and the command and commit of the
+/// last session.
 #[derive(Default, Serialize, Deserialize)]
-struct TrainingTime {
+struct TrainingRecord {
     seconds: f64,
     finished: bool,
+    /// Absent in runs trained before they were recorded.
+    #[serde(default)]
+    command: Option<String>,
+    #[serde(default)]
+    commit: Option<String>,
+}
+
+impl TrainingRecord {
+    fn now(seconds: f64, finished: bool) -> Self {
+        Self {
+            seconds,
+            finished,
+            command: Some(std::env::args().collect::<Vec<_>>().join(" ")),
+            commit: Some(commit().to_owned()),
+        }
+    }
 }
 
 /// The training time of `dir` if it holds a finished run of `config`; an error if it holds a
 /// finished run of another configuration.
 fn finished_run(dir: &Path, config: &MethodConfig) -> anyhow::Result<Option<f64>> {
     let time_path = dir.join(TIME_FILE);
-    let time: TrainingTime = if time_path.exists() { read_json(&time_path)? } else { TrainingTime::default() };
+    let time: TrainingRecord = if time_path.exists() { read_json(&time_path)? } else { TrainingRecord::default() };
     if !(time.finished && dir.join(MODEL_DIR).exists()) {
         return Ok(None);
     }
@@ -251,7 +323,7 @@ impl TimedProgress {
     /// recorded there.
     fn start(dir: &Path, label: &str, total: u64) -> anyhow::Result<Self> {
         let time_path = dir.join(TIME_FILE);
-        let before = if time_path.exists() { read_json::<TrainingTime>(&time_path)?.seconds } else { 0.0 };
+        let before = if time_path.exists() { read_json::<TrainingRecord>(&time_path)?.seconds } else { 0.0 };
         Ok(Self { inner: TrainingProgress::new(label, 0, total), time_path, before, started: Instant::now() })
     }
 
@@ -267,13 +339,13 @@ impl TimedProgress {
     /// Records the run as finished; returns its total training time.
     fn finish(self) -> anyhow::Result<f64> {
         self.inner.finish();
-        let time = TrainingTime { seconds: self.seconds(), finished: true };
+        let time = TrainingRecord::now(self.seconds(), true);
         write_json(&self.time_path, &time)?;
         Ok(time.seconds)
     }
 
     fn record(&mut self) {
-        let time = TrainingTime { seconds: self.seconds(), finished: false };
+        let time = TrainingRecord::now(self.seconds(), false);
         if let Err(e) = write_json(&self.time_path, &time) {
             self.inner.println(&format!("warning: {e:#}"));
         }

@@ -80,6 +80,21 @@ fn smoke_profile_writes_every_output_and_reuses_its_runs() {
     // Three methods × two problems; steps 1, 2, T and the expert (the CNN: its one step).
     assert_eq!(png_size(&experiment.out.join("gallery_easy.png")), (4 * 420, 6 * 380));
 
+    // Every run's model has a card with the command and commit that trained it and its scores,
+    // so `amber mesh --model <run>` takes it as it takes a shipped model.
+    for (config, run) in value["config"]["runs"].as_array().unwrap().iter().zip(&results.runs) {
+        let model = Path::new(config["run_dir"].as_str().unwrap()).join("model");
+        let card = amber_experiments::ModelCard::read(&model).unwrap();
+        assert_eq!(card.task, amber_experiments::Task::Poisson);
+        assert_eq!(card.method, run.method);
+        assert_eq!(card.commit, amber_experiments::commit());
+        assert!(card.command.contains("smoke"), "the test binary's command line: {}", card.command);
+        let evaluation = card.evaluation.unwrap();
+        assert_eq!(evaluation.normalised_dcd, run.ndcd);
+        assert_eq!(evaluation.normalised_dcd_per_step, run.ndcd_per_step);
+        assert_eq!(card.training_seconds, run.train_seconds);
+    }
+
     // A rerun trains and evaluates nothing: the same numbers come back from the caches.
     let again = experiment.run().unwrap();
     assert_eq!(again.runs, results.runs);
