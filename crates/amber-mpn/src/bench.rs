@@ -96,7 +96,7 @@ mod tests {
 
     #[test]
     fn every_step_runs_on_a_small_case() {
-        let config = MpnConfig { latent_dim: 8, steps: 2, ..MpnConfig::poisson() };
+        let config = MpnConfig::small(8, 2);
         let mut case = BenchCase::new(&config, Objective::SoftplusMse, 20, 30, 1e-3, Some(0.5)).unwrap();
         assert_eq!(case.num_edges(), 20 + 60);
         for step in [

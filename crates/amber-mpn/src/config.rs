@@ -4,21 +4,17 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{MpnError, Result};
 
-/// Hyper-parameters of the message passing network (spec §5). The defaults are the paper's
-/// Poisson configuration. Unknown fields are ignored: model files written before the output
-/// transform moved to the trainer's objective (`amber_nn::Objective`) still carry it as
-/// `output`, and the objective beside them says the same.
+/// The network's size apart from its input widths, which the task's features fix: what a
+/// training configuration chooses (spec §5). The defaults are the paper's Poisson network.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct MpnConfig {
-    /// Input features per node (Poisson: area, mean u, std u, f).
-    pub node_features: usize,
-    /// Input features per directed edge (Poisson: midpoint distance).
-    pub edge_features: usize,
-    /// Latent width D of every node and edge state.
+#[serde(default, deny_unknown_fields)]
+pub struct NetworkConfig {
+    /// Latent width D of every node and edge state (Poisson 64, Console 128).
     pub latent_dim: usize,
-    /// Message-passing steps L, each with its own weights.
-    pub steps: usize,
+    /// Message-passing steps L, each with its own weights (`steps` in model files written
+    /// before the training configuration shared this type).
+    #[serde(alias = "steps")]
+    pub message_passing_steps: usize,
     /// Probability of dropping each directed edge (self-loops included) in training mode.
     pub edge_dropout: f64,
     /// Graph context (off in the paper): every step adds `tanh(W·mean(x) + b)`, the mean node
@@ -28,6 +24,27 @@ pub struct MpnConfig {
     /// configurations without it keep their hashes.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub graph_context: bool,
+}
+
+impl Default for NetworkConfig {
+    fn default() -> Self {
+        Self { latent_dim: 64, message_passing_steps: 10, edge_dropout: 0.1, graph_context: false }
+    }
+}
+
+/// The whole network: its input widths and its size. Fields a model file holds beyond these
+/// are ignored: files written before the output transform moved to the trainer's objective
+/// (`amber_nn::Objective`) still carry it as `output`, and the objective beside them says the
+/// same.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct MpnConfig {
+    /// Input features per node (Poisson: area, mean u, std u, f).
+    pub node_features: usize,
+    /// Input features per directed edge (Poisson: midpoint distance).
+    pub edge_features: usize,
+    #[serde(flatten)]
+    pub network: NetworkConfig,
 }
 
 impl Default for MpnConfig {
@@ -40,20 +57,33 @@ impl MpnConfig {
     /// The paper's Poisson network: 4 node features, 1 edge feature, D = 64, L = 10
     /// (300,673 parameters).
     pub fn poisson() -> Self {
-        Self { node_features: 4, edge_features: 1, latent_dim: 64, steps: 10, edge_dropout: 0.1, graph_context: false }
+        Self { node_features: 4, edge_features: 1, network: NetworkConfig::default() }
     }
 
     /// The reference code's Console network: 1 node feature, 3 edge features, D = 128.
     pub fn console() -> Self {
-        Self { node_features: 1, edge_features: 3, latent_dim: 128, ..Self::poisson() }
+        Self {
+            node_features: 1,
+            edge_features: 3,
+            network: NetworkConfig { latent_dim: 128, ..NetworkConfig::default() },
+        }
+    }
+
+    /// The paper's Poisson network made `latent_dim` wide and `message_passing_steps` deep
+    /// (small networks for tests and benchmarks).
+    pub fn small(latent_dim: usize, message_passing_steps: usize) -> Self {
+        Self {
+            network: NetworkConfig { latent_dim, message_passing_steps, ..NetworkConfig::default() },
+            ..Self::poisson()
+        }
     }
 
     pub fn validate(&self) -> Result<()> {
         let bad = |m: &str| Err(MpnError::InvalidConfig(m.to_owned()));
-        if self.node_features == 0 || self.edge_features == 0 || self.latent_dim == 0 {
+        if self.node_features == 0 || self.edge_features == 0 || self.network.latent_dim == 0 {
             return bad("feature counts and latent_dim must be positive");
         }
-        if !(0.0..1.0).contains(&self.edge_dropout) {
+        if !(0.0..1.0).contains(&self.network.edge_dropout) {
             return bad("edge_dropout must be in [0, 1)");
         }
         Ok(())
@@ -62,13 +92,13 @@ impl MpnConfig {
     /// Number of trainable scalars: encoders, L × (edge MLP 3D→D→D, node MLP 2D→D→D, two
     /// affine LayerNorms, the graph context's D→D if on), decoder D→D→D→1.
     pub fn num_parameters(&self) -> usize {
-        let d = self.latent_dim;
+        let d = self.network.latent_dim;
         let linear = |i: usize, o: usize| i * o + o;
-        let context = if self.graph_context { linear(d, d) } else { 0 };
+        let context = if self.network.graph_context { linear(d, d) } else { 0 };
         let step = linear(3 * d, d) + linear(d, d) + linear(2 * d, d) + linear(d, d) + 2 * 2 * d + context;
         linear(self.node_features, d)
             + linear(self.edge_features, d)
-            + self.steps * step
+            + self.network.message_passing_steps * step
             + linear(d, d)
             + linear(d, d)
             + linear(d, 1)
@@ -83,7 +113,8 @@ mod tests {
     fn paper_parameter_counts() {
         assert_eq!(MpnConfig::poisson().num_parameters(), 300_673);
         assert_eq!(MpnConfig::console().num_parameters(), 1_191_041);
-        let with_context = MpnConfig { graph_context: true, ..MpnConfig::poisson() };
+        let mut with_context = MpnConfig::poisson();
+        with_context.network.graph_context = true;
         assert_eq!(with_context.num_parameters(), 300_673 + 10 * (64 * 64 + 64));
     }
 
@@ -93,11 +124,21 @@ mod tests {
         let back: MpnConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
         assert_eq!(back, c);
         assert!(!serde_json::to_string(&c).unwrap().contains("graph_context"));
-        let on = MpnConfig { graph_context: true, ..c };
+        let mut on = c;
+        on.network.graph_context = true;
         assert_eq!(serde_json::from_str::<MpnConfig>(&serde_json::to_string(&on).unwrap()).unwrap(), on);
-        // Earlier model files name the output transform.
-        let partial: MpnConfig = serde_json::from_str(r#"{"latent_dim": 32, "output": "none"}"#).unwrap();
-        assert_eq!(partial, MpnConfig { latent_dim: 32, ..MpnConfig::poisson() });
-        assert!(MpnConfig { edge_dropout: 1.0, ..MpnConfig::poisson() }.validate().is_err());
+        // Earlier model files name the output transform and call L `steps`.
+        let earlier: MpnConfig = serde_json::from_str(r#"{"latent_dim": 32, "steps": 3, "output": "none"}"#).unwrap();
+        assert_eq!(earlier, MpnConfig::small(32, 3));
+        let mut dropout = MpnConfig::poisson();
+        dropout.network.edge_dropout = 1.0;
+        assert!(dropout.validate().is_err());
+    }
+
+    #[test]
+    fn a_training_configuration_names_only_the_networks_fields() {
+        let network: NetworkConfig = serde_json::from_str(r#"{"latent_dim": 128}"#).unwrap();
+        assert_eq!(network, MpnConfig::console().network);
+        assert!(serde_json::from_str::<NetworkConfig>(r#"{"latnet_dim": 128}"#).is_err());
     }
 }

@@ -13,7 +13,7 @@
 //! use amber_nn::Objective;
 //! use candle_core::{DType, Device};
 //!
-//! let config = MpnConfig { latent_dim: 8, steps: 2, ..MpnConfig::poisson() };
+//! let config = MpnConfig::small(8, 2);
 //! let (model, _vars) = Mpn::init(config, 0, DType::F32, &Device::Cpu)?;
 //! let batch = amber_mpn::synthetic::random_graph(10, 15, 4, 1, 0);
 //! let z = model.predict(&batch)?;
@@ -33,7 +33,7 @@ mod ops;
 pub mod synthetic;
 mod train;
 
-pub use config::MpnConfig;
+pub use config::{MpnConfig, NetworkConfig};
 pub use error::{MpnError, Result};
 pub use graph::{GraphInput, Topology};
 pub use model::Mpn;

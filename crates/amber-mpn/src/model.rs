@@ -132,14 +132,14 @@ impl Mpn {
     /// `node`, `steps.{l}.context.{weight,bias}` with a graph context, and `decoder.{0,1,2}.*`.
     pub fn new(config: MpnConfig, vb: VarBuilder) -> Result<Self> {
         config.validate()?;
-        let d = config.latent_dim;
-        let steps = (0..config.steps)
+        let d = config.network.latent_dim;
+        let steps = (0..config.network.message_passing_steps)
             .map(|l| {
                 let vb = vb.pp("steps").pp(l);
                 Ok(Step {
                     edge: ResidualMlp::new(vb.pp("edge"), 3 * d, d)?,
                     node: ResidualMlp::new(vb.pp("node"), 2 * d, d)?,
-                    context: config.graph_context.then(|| Linear::new(vb.pp("context"), d, d)).transpose()?,
+                    context: config.network.graph_context.then(|| Linear::new(vb.pp("context"), d, d)).transpose()?,
                 })
             })
             .collect::<candle_core::Result<_>>()?;
@@ -277,8 +277,8 @@ impl Mpn {
     /// Training-mode forward: edge dropout with the configured rate, one dropped graph for all
     /// steps, drawn from `rng`.
     pub fn forward_train<R: Rng + ?Sized>(&self, graph: &GraphInput, rng: &mut R) -> Result<Tensor> {
-        if self.config.edge_dropout > 0.0 {
-            self.forward(&graph.drop_edges(self.config.edge_dropout, rng)?)
+        if self.config.network.edge_dropout > 0.0 {
+            self.forward(&graph.drop_edges(self.config.network.edge_dropout, rng)?)
         } else {
             self.forward(graph)
         }

@@ -9,11 +9,12 @@ use rand::SeedableRng;
 use rand::rngs::StdRng;
 
 fn small_config() -> MpnConfig {
-    MpnConfig { latent_dim: 8, steps: 3, ..MpnConfig::poisson() }
+    MpnConfig::small(8, 3)
 }
 
-fn with_context(config: MpnConfig) -> MpnConfig {
-    MpnConfig { graph_context: true, ..config }
+fn with_context(mut config: MpnConfig) -> MpnConfig {
+    config.network.graph_context = true;
+    config
 }
 
 /// `a` and `b` side by side, as two graphs of one batch or (`one_graph`) as one graph with two
@@ -154,7 +155,9 @@ fn f32_matches_f64() {
 
 #[test]
 fn dropout_is_reproducible_and_only_in_training() {
-    let (model, _) = Mpn::init(MpnConfig { edge_dropout: 0.3, ..small_config() }, 0, DType::F32, &Device::Cpu).unwrap();
+    let mut config = small_config();
+    config.network.edge_dropout = 0.3;
+    let (model, _) = Mpn::init(config, 0, DType::F32, &Device::Cpu).unwrap();
     let g = graph(DType::F32, 4);
     let train = |seed| values(&model.forward_train(&g, &mut StdRng::seed_from_u64(seed)).unwrap());
     assert_eq!(train(7), train(7));
@@ -202,7 +205,7 @@ fn checkpoints_round_trip_and_reject_wrong_shapes() {
     assert_eq!(vars.all_vars().len(), model.parameters().len());
 
     // The same weights under a configuration with another width or depth.
-    for config in [MpnConfig { latent_dim: 16, ..small_config() }, MpnConfig { steps: 2, ..small_config() }] {
+    for config in [MpnConfig::small(16, 3), MpnConfig::small(8, 2)] {
         std::fs::write(path.with_extension("json"), serde_json::to_string(&config).unwrap()).unwrap();
         assert!(matches!(Mpn::load(&path), Err(MpnError::Checkpoint { .. })));
         assert!(matches!(Mpn::load_trainable(&path), Err(MpnError::Checkpoint { .. })));

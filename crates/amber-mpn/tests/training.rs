@@ -9,7 +9,7 @@ use rand::{Rng, SeedableRng};
 
 #[test]
 fn training_lowers_the_loss_tenfold() {
-    let config = MpnConfig { latent_dim: 32, steps: 3, ..MpnConfig::poisson() };
+    let config = MpnConfig::small(32, 3);
     let objective = Objective::SoftplusMse;
     let mut trainer = MpnTrainer::new(config, objective, 0, Some(0.5)).unwrap();
     let mut rng = StdRng::seed_from_u64(0);

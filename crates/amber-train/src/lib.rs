@@ -32,9 +32,10 @@ mod observer;
 mod rollout;
 
 pub use amber::{
-    Addition, AmberModel, AmberSizing, AmberStepReport, BufferEntry, CONFIG_FILE, LOG_FILE, MODEL_DIR, NetworkConfig,
-    Predictor, ReplayBuffer, Sample, SourceSelection, TargetTransform, Training, TrainingConfig, WEIGHTS_FILE,
+    Addition, AmberModel, AmberSizing, AmberStepReport, BufferEntry, CONFIG_FILE, LOG_FILE, MODEL_DIR, Predictor,
+    ReplayBuffer, Sample, SourceSelection, TargetTransform, Training, TrainingConfig, WEIGHTS_FILE,
 };
+pub use amber_mpn::NetworkConfig;
 pub use amber_nn::Objective;
 pub use checkpoint::{AdditionCounts, CHECKPOINTS_DIR, latest_checkpoint};
 pub use cnn::{

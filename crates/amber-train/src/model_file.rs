@@ -67,7 +67,7 @@ mod tests {
 
     /// An untrained AMBER model (the console features: one node and two edge columns).
     fn amber_model(dir: &Path) {
-        let network = MpnConfig { node_features: 1, edge_features: 2, latent_dim: 4, steps: 1, ..MpnConfig::poisson() };
+        let network = MpnConfig { node_features: 1, edge_features: 2, ..MpnConfig::small(4, 1) };
         let predictor = Predictor {
             features: FeatureSet::console(),
             normaliser: Some(FeatureNormaliser::new(1, 2)),

@@ -1,6 +1,7 @@
 //! Every knob of an AMBER training run ([`TrainingConfig`]) and its named profiles.
 
 use amber_graph::Aggregation;
+use amber_mpn::NetworkConfig;
 use amber_nn::Objective;
 use serde::{Deserialize, Serialize};
 
@@ -16,28 +17,6 @@ pub enum SourceSelection {
     Stratified,
     /// An entry uniformly among all entries of allowed depth (the "random additions" ablation).
     Uniform,
-}
-
-/// Size of the message passing network; the feature widths come from the task.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct NetworkConfig {
-    /// Latent width D (Poisson 64, Console 128).
-    pub latent_dim: usize,
-    /// Message-passing steps L.
-    pub message_passing_steps: usize,
-    /// Edge dropout probability during training.
-    pub edge_dropout: f64,
-    /// The graph context of `amber_mpn::MpnConfig::graph_context` (not in the paper); omitted
-    /// from the JSON when off, so configurations without it keep their hashes.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub graph_context: bool,
-}
-
-impl Default for NetworkConfig {
-    fn default() -> Self {
-        Self { latent_dim: 64, message_passing_steps: 10, edge_dropout: 0.1, graph_context: false }
-    }
 }
 
 /// Every knob of a training run. Defaults are the `quick` profile.

@@ -8,7 +8,7 @@ mod target;
 mod train;
 
 pub use buffer::{BufferEntry, ReplayBuffer, Sample};
-pub use config::{NetworkConfig, SourceSelection, TrainingConfig};
+pub use config::{SourceSelection, TrainingConfig};
 pub(crate) use model::PREDICTOR_FILE;
 pub use model::{AmberModel, AmberSizing, Predictor, WEIGHTS_FILE};
 pub use target::TargetTransform;

@@ -112,10 +112,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let network_config = MpnConfig {
             node_features: features.node_dim(),
             edge_features: features.edge_dim(D),
-            latent_dim: config.network.latent_dim,
-            steps: config.network.message_passing_steps,
-            edge_dropout: config.network.edge_dropout,
-            graph_context: config.network.graph_context,
+            network: config.network.clone(),
         };
         let trainer = MpnTrainer::new(network_config, config.objective, config.seed, config.max_grad_norm)?;
         let mut training = Self {
