@@ -2,8 +2,6 @@
 //! faces meet), the geometric inputs a model of expert meshing reads: an expert refines near
 //! holes, bends and thin walls, which an element's own size and volume do not show.
 
-use std::collections::BTreeMap;
-
 use nalgebra::Vector3;
 use rstar::primitives::{GeomWithData, Line};
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
@@ -22,23 +20,13 @@ pub struct SurfaceDistance {
 impl SurfaceDistance {
     /// Indexes `surface` (any closed surface whose triangles carry CAD face ids).
     pub fn new(surface: &Surface) -> Self {
-        let (v, t, ids) = (surface.vertices(), surface.triangles(), surface.face_ids());
+        let (v, t) = (surface.vertices(), surface.triangles());
         let corners = |tri: &[u32; 3]| tri.map(|i| v[i as usize]);
-        let mut edge_triangles: BTreeMap<[u32; 2], Vec<usize>> = BTreeMap::new();
-        for (k, tri) in t.iter().enumerate() {
-            for j in 0..3 {
-                let (a, b) = (tri[j], tri[(j + 1) % 3]);
-                edge_triangles.entry([a.min(b), a.max(b)]).or_default().push(k);
-            }
-        }
-        let curves = edge_triangles
-            .into_iter()
-            .filter_map(|([a, b], around)| match around[..] {
-                [k, l] if ids[k] != ids[l] => {
-                    let turn = unit_normal(corners(&t[k])).dot(&unit_normal(corners(&t[l]))).clamp(-1.0, 1.0).acos();
-                    Some(GeomWithData::new(Line::new(v[a as usize], v[b as usize]), turn))
-                }
-                _ => None,
+        let curves = surface
+            .feature_edges()
+            .map(|([a, b], [k, l])| {
+                let turn = unit_normal(corners(&t[k])).dot(&unit_normal(corners(&t[l]))).clamp(-1.0, 1.0).acos();
+                GeomWithData::new(Line::new(v[a as usize], v[b as usize]), turn)
             })
             .collect();
         Self {

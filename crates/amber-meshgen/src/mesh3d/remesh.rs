@@ -144,21 +144,13 @@ impl Projector {
     fn new(reference: &Surface) -> Self {
         let (v, t, ids) = (reference.vertices(), reference.triangles(), reference.face_ids());
         let mut faces: BTreeMap<i32, Vec<RefTriangle>> = BTreeMap::new();
-        let mut edge_faces: BTreeMap<[u32; 2], Vec<i32>> = BTreeMap::new();
         for (tri, &id) in t.iter().zip(ids) {
             faces.entry(id).or_default().push(RefTriangle(tri.map(|i| v[i as usize])));
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                edge_faces.entry([a.min(b), a.max(b)]).or_default().push(id);
-            }
         }
         let mut curves: BTreeMap<(i32, i32), Vec<Line<[f64; 3]>>> = BTreeMap::new();
-        for ([a, b], ids) in edge_faces {
-            if let [f, g] = ids[..]
-                && f != g
-            {
-                curves.entry((f.min(g), f.max(g))).or_default().push(Line::new(v[a as usize], v[b as usize]));
-            }
+        for ([a, b], [k, l]) in reference.feature_edges() {
+            let (f, g) = (ids[k], ids[l]);
+            curves.entry((f.min(g), f.max(g))).or_default().push(Line::new(v[a as usize], v[b as usize]));
         }
         let planes: HashMap<i32, (Vector3<f64>, Vector3<f64>)> =
             faces.iter().filter_map(|(&id, tris)| Some((id, plane_of(tris)?))).collect();

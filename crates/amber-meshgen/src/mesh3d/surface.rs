@@ -8,7 +8,7 @@
 //! [`StlFaceIds::FromFile`].
 
 use std::cmp::Ordering;
-use std::collections::{HashMap, VecDeque};
+use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::path::{Path, PathBuf};
 
 pub use amber_mesh::StlFaceIds;
@@ -217,13 +217,7 @@ impl Surface {
         };
         let normals: Vec<Vector3<f64>> = self.triangles.iter().map(normal).collect();
         let cos_limit = angle_degrees.to_radians().cos();
-        let mut by_edge: HashMap<[u32; 2], Vec<usize>> = HashMap::with_capacity(3 * self.triangles.len() / 2);
-        for (t, tri) in self.triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                by_edge.entry([a.min(b), a.max(b)]).or_default().push(t);
-            }
-        }
+        let by_edge = self.edge_triangles();
         let mut face = vec![0i32; self.triangles.len()];
         let mut next_id = 0;
         let mut queue = VecDeque::new();
@@ -251,6 +245,27 @@ impl Surface {
         }
         self.face_ids = face;
         self.valid = false;
+    }
+
+    /// The triangles around every edge (its vertices in increasing order), edges in order.
+    fn edge_triangles(&self) -> BTreeMap<[u32; 2], Vec<usize>> {
+        let mut by_edge: BTreeMap<[u32; 2], Vec<usize>> = BTreeMap::new();
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                by_edge.entry([a.min(b), a.max(b)]).or_default().push(t);
+            }
+        }
+        by_edge
+    }
+
+    /// The edges between two CAD faces (the feature curves' pieces), in order: each edge's
+    /// vertices and its two triangles.
+    pub fn feature_edges(&self) -> impl Iterator<Item = ([u32; 2], [usize; 2])> + '_ {
+        self.edge_triangles().into_iter().filter_map(|(edge, around)| match around[..] {
+            [k, l] if self.face_ids[k] != self.face_ids[l] => Some((edge, [k, l])),
+            _ => None,
+        })
     }
 
     /// Whether [`Surface::validate`] has succeeded on this surface.
