@@ -901,6 +901,7 @@ int expansion_sum_zeroelim2(int elen, REAL *e, int flen, REAL *f, REAL *h)
 int fast_expansion_sum(int elen, REAL *e, int flen, REAL *f, REAL *h)
 /* h cannot be e or f. */
 {
+  // amber: loads of e[eindex] and f[findex] are guarded, so none reads past an input
   REAL Q;
   INEXACT REAL Qnew;
   INEXACT REAL bvirt;
@@ -913,29 +914,29 @@ int fast_expansion_sum(int elen, REAL *e, int flen, REAL *f, REAL *h)
   eindex = findex = 0;
   if ((fnow > enow) == (fnow > -enow)) {
     Q = enow;
-    enow = e[++eindex];
+    if (++eindex < elen) enow = e[eindex];
   } else {
     Q = fnow;
-    fnow = f[++findex];
+    if (++findex < flen) fnow = f[findex];
   }
   hindex = 0;
   if ((eindex < elen) && (findex < flen)) {
     if ((fnow > enow) == (fnow > -enow)) {
       Fast_Two_Sum(enow, Q, Qnew, h[0]);
-      enow = e[++eindex];
+      if (++eindex < elen) enow = e[eindex];
     } else {
       Fast_Two_Sum(fnow, Q, Qnew, h[0]);
-      fnow = f[++findex];
+      if (++findex < flen) fnow = f[findex];
     }
     Q = Qnew;
     hindex = 1;
     while ((eindex < elen) && (findex < flen)) {
       if ((fnow > enow) == (fnow > -enow)) {
         Two_Sum(Q, enow, Qnew, h[hindex]);
-        enow = e[++eindex];
+        if (++eindex < elen) enow = e[eindex];
       } else {
         Two_Sum(Q, fnow, Qnew, h[hindex]);
-        fnow = f[++findex];
+        if (++findex < flen) fnow = f[findex];
       }
       Q = Qnew;
       hindex++;
@@ -943,13 +944,13 @@ int fast_expansion_sum(int elen, REAL *e, int flen, REAL *f, REAL *h)
   }
   while (eindex < elen) {
     Two_Sum(Q, enow, Qnew, h[hindex]);
-    enow = e[++eindex];
+    if (++eindex < elen) enow = e[eindex];
     Q = Qnew;
     hindex++;
   }
   while (findex < flen) {
     Two_Sum(Q, fnow, Qnew, h[hindex]);
-    fnow = f[++findex];
+    if (++findex < flen) fnow = f[findex];
     Q = Qnew;
     hindex++;
   }
@@ -974,6 +975,7 @@ int fast_expansion_sum(int elen, REAL *e, int flen, REAL *f, REAL *h)
 int fast_expansion_sum_zeroelim(int elen, REAL *e, int flen, REAL *f, REAL *h)
 /* h cannot be e or f. */
 {
+  // amber: loads of e[eindex] and f[findex] are guarded, so none reads past an input
   REAL Q;
   INEXACT REAL Qnew;
   INEXACT REAL hh;
@@ -987,19 +989,19 @@ int fast_expansion_sum_zeroelim(int elen, REAL *e, int flen, REAL *f, REAL *h)
   eindex = findex = 0;
   if ((fnow > enow) == (fnow > -enow)) {
     Q = enow;
-    enow = e[++eindex];
+    if (++eindex < elen) enow = e[eindex];
   } else {
     Q = fnow;
-    fnow = f[++findex];
+    if (++findex < flen) fnow = f[findex];
   }
   hindex = 0;
   if ((eindex < elen) && (findex < flen)) {
     if ((fnow > enow) == (fnow > -enow)) {
       Fast_Two_Sum(enow, Q, Qnew, hh);
-      enow = e[++eindex];
+      if (++eindex < elen) enow = e[eindex];
     } else {
       Fast_Two_Sum(fnow, Q, Qnew, hh);
-      fnow = f[++findex];
+      if (++findex < flen) fnow = f[findex];
     }
     Q = Qnew;
     if (hh != 0.0) {
@@ -1008,10 +1010,10 @@ int fast_expansion_sum_zeroelim(int elen, REAL *e, int flen, REAL *f, REAL *h)
     while ((eindex < elen) && (findex < flen)) {
       if ((fnow > enow) == (fnow > -enow)) {
         Two_Sum(Q, enow, Qnew, hh);
-        enow = e[++eindex];
+        if (++eindex < elen) enow = e[eindex];
       } else {
         Two_Sum(Q, fnow, Qnew, hh);
-        fnow = f[++findex];
+        if (++findex < flen) fnow = f[findex];
       }
       Q = Qnew;
       if (hh != 0.0) {
@@ -1021,7 +1023,7 @@ int fast_expansion_sum_zeroelim(int elen, REAL *e, int flen, REAL *f, REAL *h)
   }
   while (eindex < elen) {
     Two_Sum(Q, enow, Qnew, hh);
-    enow = e[++eindex];
+    if (++eindex < elen) enow = e[eindex];
     Q = Qnew;
     if (hh != 0.0) {
       h[hindex++] = hh;
@@ -1029,7 +1031,7 @@ int fast_expansion_sum_zeroelim(int elen, REAL *e, int flen, REAL *f, REAL *h)
   }
   while (findex < flen) {
     Two_Sum(Q, fnow, Qnew, hh);
-    fnow = f[++findex];
+    if (++findex < flen) fnow = f[findex];
     Q = Qnew;
     if (hh != 0.0) {
       h[hindex++] = hh;
@@ -1055,6 +1057,7 @@ int fast_expansion_sum_zeroelim(int elen, REAL *e, int flen, REAL *f, REAL *h)
 int linear_expansion_sum(int elen, REAL *e, int flen, REAL *f, REAL *h)
 /* h cannot be e or f. */
 {
+  // amber: loads of e[eindex] and f[findex] are guarded, so none reads past an input
   REAL Q, q;
   INEXACT REAL Qnew;
   INEXACT REAL R;
@@ -1069,28 +1072,28 @@ int linear_expansion_sum(int elen, REAL *e, int flen, REAL *f, REAL *h)
   eindex = findex = 0;
   if ((fnow > enow) == (fnow > -enow)) {
     g0 = enow;
-    enow = e[++eindex];
+    if (++eindex < elen) enow = e[eindex];
   } else {
     g0 = fnow;
-    fnow = f[++findex];
+    if (++findex < flen) fnow = f[findex];
   }
   if ((eindex < elen) && ((findex >= flen)
                           || ((fnow > enow) == (fnow > -enow)))) {
     Fast_Two_Sum(enow, g0, Qnew, q);
-    enow = e[++eindex];
+    if (++eindex < elen) enow = e[eindex];
   } else {
     Fast_Two_Sum(fnow, g0, Qnew, q);
-    fnow = f[++findex];
+    if (++findex < flen) fnow = f[findex];
   }
   Q = Qnew;
   for (hindex = 0; hindex < elen + flen - 2; hindex++) {
     if ((eindex < elen) && ((findex >= flen)
                             || ((fnow > enow) == (fnow > -enow)))) {
       Fast_Two_Sum(enow, q, R, h[hindex]);
-      enow = e[++eindex];
+      if (++eindex < elen) enow = e[eindex];
     } else {
       Fast_Two_Sum(fnow, q, R, h[hindex]);
-      fnow = f[++findex];
+      if (++findex < flen) fnow = f[findex];
     }
     Two_Sum(Q, R, Qnew, q);
     Q = Qnew;
@@ -1116,6 +1119,7 @@ int linear_expansion_sum_zeroelim(int elen, REAL *e, int flen, REAL *f,
                                   REAL *h)
 /* h cannot be e or f. */
 {
+  // amber: loads of e[eindex] and f[findex] are guarded, so none reads past an input
   REAL Q, q, hh;
   INEXACT REAL Qnew;
   INEXACT REAL R;
@@ -1132,28 +1136,28 @@ int linear_expansion_sum_zeroelim(int elen, REAL *e, int flen, REAL *f,
   hindex = 0;
   if ((fnow > enow) == (fnow > -enow)) {
     g0 = enow;
-    enow = e[++eindex];
+    if (++eindex < elen) enow = e[eindex];
   } else {
     g0 = fnow;
-    fnow = f[++findex];
+    if (++findex < flen) fnow = f[findex];
   }
   if ((eindex < elen) && ((findex >= flen)
                           || ((fnow > enow) == (fnow > -enow)))) {
     Fast_Two_Sum(enow, g0, Qnew, q);
-    enow = e[++eindex];
+    if (++eindex < elen) enow = e[eindex];
   } else {
     Fast_Two_Sum(fnow, g0, Qnew, q);
-    fnow = f[++findex];
+    if (++findex < flen) fnow = f[findex];
   }
   Q = Qnew;
   for (count = 2; count < elen + flen; count++) {
     if ((eindex < elen) && ((findex >= flen)
                             || ((fnow > enow) == (fnow > -enow)))) {
       Fast_Two_Sum(enow, q, R, hh);
-      enow = e[++eindex];
+      if (++eindex < elen) enow = e[eindex];
     } else {
       Fast_Two_Sum(fnow, q, R, hh);
-      fnow = f[++findex];
+      if (++findex < flen) fnow = f[findex];
     }
     Two_Sum(Q, R, Qnew, q);
     Q = Qnew;
