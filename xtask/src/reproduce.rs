@@ -39,6 +39,9 @@ struct ConsoleArgs {
     /// Train on all 19 training parts instead of the paper's 15.
     #[arg(long)]
     all_train: bool,
+    /// Training seeds 0..N (default: the profile's).
+    #[arg(long)]
+    seeds: Option<usize>,
     /// Methods, comma-separated (default: the profile's).
     #[arg(long, value_delimiter = ',')]
     methods: Vec<Method>,
@@ -135,6 +138,9 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
     let mut experiment = ConsoleExperiment::new(args.profile, &args.data);
     if args.all_train {
         experiment.train_set = TrainSet::All;
+    }
+    if let Some(seeds) = args.seeds {
+        experiment.seeds = seeds;
     }
     if !args.methods.is_empty() {
         experiment.methods = args.methods.into_iter().map(MethodSpec::plain).collect();
