@@ -204,12 +204,12 @@ impl TrainingConfig {
         }
         // Upper bounds that a machine can hold, so that a typo is an error, not an abort.
         let limits: [(&str, u64, u64); 7] = [
-            ("network.latent_dim", self.network.latent_dim as u64, 4_096),
+            ("network.latent_dim", self.network.latent_dim as u64, 1_024),
             ("network.message_passing_steps", self.network.message_passing_steps as u64, 256),
             ("batch_nodes", self.batch_nodes as u64, 100_000_000),
             ("buffer_capacity", self.buffer_capacity as u64, 1_000_000),
-            ("data.train_problems", self.data.train_problems as u64, 1_000_000),
-            ("data.val_problems", self.data.val_problems as u64, 1_000_000),
+            ("data.train_problems", self.data.train_problems as u64, 100_000),
+            ("data.val_problems", self.data.val_problems as u64, 100_000),
             ("inference_steps", self.inference_steps as u64, 10_000),
         ];
         if let Some((field, value, max)) = limits.into_iter().find(|&(_, value, max)| value > max) {
@@ -244,6 +244,6 @@ mod tests {
             ..TrainingConfig::quick()
         };
         let message = huge.validate().unwrap_err().to_string();
-        assert!(message.contains("network.latent_dim") && message.contains("4096"), "{message}");
+        assert!(message.contains("network.latent_dim") && message.contains("1024"), "{message}");
     }
 }
