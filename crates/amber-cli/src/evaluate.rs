@@ -138,11 +138,8 @@ impl Run<'_> {
         let evaluation = Evaluation::new(&parts, self.model.limits())?;
         let rollouts = self.model.rollouts(&evaluation, self.steps)?;
         let summary = EvaluationSummary::new(&parts, &rollouts);
-        let scores: Vec<ProblemEvaluation> = rollouts
-            .iter()
-            .zip(&parts)
-            .map(|(r, p)| ProblemEvaluation::of(r, p.expert_mesh().num_elements()))
-            .collect();
+        let scores: Vec<ProblemEvaluation> =
+            rollouts.iter().zip(&parts).map(|(r, p)| ProblemEvaluation::of(r, p)).collect();
         let out = &self.args.out;
         std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
         let mut pictures = Vec::new();

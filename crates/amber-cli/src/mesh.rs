@@ -12,7 +12,7 @@ use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
 use amber_tasks::part::{
     FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, read_polygon_domain, read_solid_surface,
 };
-use amber_tasks::poisson::{PoissonPart, read_part, read_problem};
+use amber_tasks::poisson::{PoissonPart, read_part};
 use amber_tasks::{Domain, WithExpert};
 use amber_train::{ElementTarget, GeneratedStep, MeshMetrics, Reference, TrainError, TrainedModel};
 use anyhow::{Context, bail};
@@ -92,13 +92,13 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             let problem = args.problem.as_deref().with_context(|| {
                 format!("the model `{model}` reads the load f of a Poisson problem: give it with --problem FILE.json")
             })?;
-            let mut part = read_part(problem)?;
+            let (mut part, file_expert) = read_part(problem)?;
             if args.geometry.is_some() {
                 part = PoissonPart::new(planar_domain(args)?, part.load, None, part.quadrature_order)?;
             }
             let expert = match &args.expert {
-                Some(path) => Some(read_mesh::<2>(path)?),
-                None if args.geometry.is_none() => read_problem(problem).ok().map(|p| p.expert_mesh),
+                Some(path) => Some((read_mesh::<2>(path)?, path.clone())),
+                None if args.geometry.is_none() => file_expert.map(|mesh| (mesh, problem.to_path_buf())),
                 None => None,
             };
             mesh_domain(args, &trained, part, expert, steps)
@@ -110,7 +110,7 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             let mut part = SolidPart::new(part_name(geometry), surface, card.initial_size)
                 .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
             part.inputs = part_inputs(args)?;
-            let expert = args.expert.as_deref().map(read_mesh::<3>).transpose()?;
+            let expert = args.expert.as_ref().map(|p| read_mesh::<3>(p).map(|m| (m, p.clone()))).transpose()?;
             mesh_domain(args, &trained, part, expert, steps)
         }
         Task::Folder { dimension: 2 } => {
@@ -118,7 +118,7 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             let mut part = PlanarPart::new(part_name(geometry), planar_domain(args)?, card.initial_size)
                 .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
             part.inputs = part_inputs(args)?;
-            let expert = args.expert.as_deref().map(read_mesh::<2>).transpose()?;
+            let expert = args.expert.as_ref().map(|p| read_mesh::<2>(p).map(|m| (m, p.clone()))).transpose()?;
             mesh_domain(args, &trained, part, expert, steps)
         }
         Task::Folder { dimension } => {
@@ -150,7 +150,7 @@ fn mesh_domain<const D: usize, P: Domain<D>>(
     args: &MeshArgs,
     model: &TrainedModel,
     domain: P,
-    expert: Option<Mesh<D>>,
+    expert: Option<(Mesh<D>, PathBuf)>,
     steps: usize,
 ) -> anyhow::Result<()>
 where
@@ -163,7 +163,7 @@ where
         e => e.into(),
     })?;
     let seconds = start.elapsed().as_secs_f64();
-    let scored = expert.map(|expert_mesh| WithExpert { domain, expert_mesh });
+    let scored = expert.map(|(mesh, path)| WithExpert::new(domain, mesh, &path)).transpose()?;
     let reference = scored.as_ref().map(|p| Reference::new(p, model.limits())).transpose()?;
     let metrics: Vec<Option<MeshMetrics>> = generated
         .iter()

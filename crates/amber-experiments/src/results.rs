@@ -1,13 +1,22 @@
 //! The results schema every experiment writes (`results.json`): per-problem evaluations are
 //! reduced to one [`RunResult`] per (method, variant, difficulty, seed).
 
+use amber_mesh::Mesh;
 use amber_stdx::quantile;
+use amber_tasks::Problem;
 use amber_train::{MeshMetrics, Rollout, StepStatus};
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 
 /// One test problem's rollout, as cached beside a trained run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ProblemEvaluation {
+    /// The problem's name ([`Problem::name`]); unknown in evaluations cached before schema 3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// SHA-256 of the expert mesh ([`mesh_sha256`]): which data the problem was.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub expert_sha256: Option<String>,
     /// M⁰ against the expert.
     pub initial: MeshMetrics,
     /// Status and metrics after each generation step (failed steps carry the last mesh).
@@ -28,9 +37,11 @@ pub struct StepEvaluation {
 }
 
 impl ProblemEvaluation {
-    /// The record of `rollout` of a problem whose expert has `expert_elements` elements.
-    pub fn of<const D: usize>(rollout: &Rollout<D>, expert_elements: usize) -> Self {
+    /// The record of `rollout` of `problem`.
+    pub fn of<const D: usize>(rollout: &Rollout<D>, problem: &impl Problem<D>) -> Self {
         Self {
+            name: Some(problem.name()),
+            expert_sha256: Some(mesh_sha256(problem.expert_mesh())),
             initial: rollout.initial,
             steps: rollout
                 .steps
@@ -39,7 +50,7 @@ impl ProblemEvaluation {
                 .collect(),
             initial_dcd: rollout.initial_dcd,
             reconstruction_dcd: rollout.reconstruction_dcd,
-            expert_elements,
+            expert_elements: problem.expert_mesh().num_elements(),
         }
     }
 
@@ -47,6 +58,17 @@ impl ProblemEvaluation {
     pub fn last(&self) -> &MeshMetrics {
         self.steps.last().map_or(&self.initial, |s| &s.metrics)
     }
+}
+
+/// SHA-256 (hex) of a mesh's vertices (little-endian f64) followed by its cells (little-endian
+/// u32): equal for the same mesh read from any file format.
+pub fn mesh_sha256<const D: usize>(mesh: &Mesh<D>) -> String {
+    let mut hasher = Sha256::new();
+    for v in mesh.vertices() {
+        v.iter().for_each(|c| hasher.update(c.to_le_bytes()));
+    }
+    mesh.cells().iter().for_each(|c| hasher.update(c.to_le_bytes()));
+    hasher.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// One trained and evaluated configuration: the means over the test problems.
@@ -58,6 +80,10 @@ pub struct RunResult {
     pub seed: usize,
     /// Test problems evaluated.
     pub test_problems: usize,
+    /// SHA-256 of the test problems' expert mesh hashes in order: the same for the same test
+    /// data; absent where an evaluation was cached before schema 3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub test_data_sha256: Option<String>,
     /// Mean normalised DCD after the last generation step.
     pub ndcd: f64,
     /// 25 % and 75 % quantiles of the per-problem final normalised DCD.
@@ -108,6 +134,12 @@ impl RunResult {
             difficulty: key.difficulty.into(),
             seed: key.seed,
             test_problems: problems.len(),
+            test_data_sha256: problems.iter().map(|p| p.expert_sha256.as_deref()).collect::<Option<Vec<_>>>().map(
+                |hashes| {
+                    let digest = Sha256::digest(hashes.concat().as_bytes());
+                    digest.iter().map(|b| format!("{b:02x}")).collect()
+                },
+            ),
             ndcd: mean(&|p| p.last().normalised_dcd),
             ndcd_quantiles: [quantile(&finals, 0.25), quantile(&finals, 0.75)],
             ndcd_per_step: (0..steps).map(|t| mean(&|p| p.steps[t].metrics.normalised_dcd)).collect(),
@@ -130,8 +162,8 @@ impl RunResult {
 }
 
 /// Version of the `results.json` schema: 2 added the per-problem values, the schema and amber
-/// versions, and a commit that is always named.
-pub const RESULTS_SCHEMA: u32 = 2;
+/// versions, and a commit that is always named; 3 the problems' names and data hashes.
+pub const RESULTS_SCHEMA: u32 = 3;
 
 /// `results.json`: one experiment.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -199,6 +231,8 @@ mod tests {
             })
             .collect();
         ProblemEvaluation {
+            name: None,
+            expert_sha256: None,
             initial: metrics(1.0),
             steps,
             initial_dcd: 0.5,

@@ -159,7 +159,7 @@ impl Run {
         let rollouts = model.rollouts(&evaluation, config.inference_steps())?;
         let eval_seconds = started.elapsed().as_secs_f64();
         let problems: Vec<ProblemEvaluation> =
-            rollouts.iter().zip(test).map(|(r, p)| ProblemEvaluation::of(r, p.expert_mesh().num_elements())).collect();
+            rollouts.iter().zip(test).map(|(r, p)| ProblemEvaluation::of(r, p)).collect();
         self.save_gallery_meshes(&rollouts)?;
         let summary = EvaluationSummary::new(test, &rollouts);
         println!(

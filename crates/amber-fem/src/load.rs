@@ -50,8 +50,8 @@ pub struct GaussianMixture {
 }
 
 impl GaussianMixture {
-    /// Checks the components: equal counts, finite values, non-negative weights summing to 1
-    /// (to 1e-9), symmetric positive definite covariances.
+    /// Checks the components: at least one, equal counts, finite values, non-negative weights
+    /// summing to 1 (to 1e-9), symmetric positive definite covariances.
     pub fn new(params: GaussianMixtureParams) -> Result<Self, FemError> {
         let n = params.means.len();
         let invalid = |component: usize, problem: String| FemError::InvalidMixture { component, problem };
@@ -65,8 +65,11 @@ impl GaussianMixture {
                 ),
             ));
         }
+        if n == 0 {
+            return Err(invalid(0, "no components: a load needs at least one Gaussian".into()));
+        }
         let total: f64 = params.weights.iter().sum();
-        if n > 0 && (total - 1.0).abs() > 1e-9 {
+        if (total - 1.0).abs() > 1e-9 {
             return Err(invalid(0, format!("weights sum to {total}, not 1")));
         }
         let mut terms = Vec::with_capacity(n);
@@ -159,6 +162,8 @@ mod tests {
         let mut p = params();
         p.covariances[0] = [[1e-3, 1e-4], [0.0, 1e-3]];
         assert!(GaussianMixture::new(p).is_err());
+        let empty = GaussianMixtureParams { means: vec![], covariances: vec![], weights: vec![] };
+        assert!(GaussianMixture::new(empty).unwrap_err().to_string().contains("at least one Gaussian"));
     }
 
     #[test]

@@ -18,22 +18,20 @@ impl FacetAdjacency {
 
     /// Builds the adjacency by sorting facet keys (O(n log n), deterministic).
     ///
-    /// Fails if a facet is shared by more than two elements.
+    /// Fails if a facet is shared by more than two elements, or by two that lie on the same side
+    /// of it (overlapping elements, such as a listed twice): a conforming mesh has neither.
     pub fn new<const D: usize>(mesh: &Mesh<D>) -> Result<Self, MeshError> {
         let n = D + 1;
-        let mut facets: Vec<([u32; 3], u32)> = Vec::with_capacity(mesh.cells().len());
+        // (sorted vertices, whether sorting the outward listing took an odd permutation, slot).
+        let mut facets: Vec<([u32; 3], bool, u32)> = Vec::with_capacity(mesh.cells().len());
         for (e, cell) in mesh.elements().enumerate() {
-            for i in 0..n {
+            for (i, local) in outward_facets::<D>().iter().enumerate() {
                 let mut key = [u32::MAX; 3];
-                let mut k = 0;
-                for (j, &v) in cell.iter().enumerate() {
-                    if j != i {
-                        key[k] = v;
-                        k += 1;
-                    }
+                for (k, &j) in local.iter().enumerate() {
+                    key[k] = cell[j];
                 }
-                key[..D].sort_unstable();
-                facets.push((key, (e * n + i) as u32));
+                let odd = sort_parity(&mut key[..D]);
+                facets.push((key, odd, (e * n + i) as u32));
             }
         }
         facets.sort_unstable();
@@ -47,7 +45,11 @@ impl FacetAdjacency {
             match j - i {
                 1 => {}
                 2 => {
-                    let (a, b) = (facets[i].1 as usize, facets[i + 1].1 as usize);
+                    let (a, b) = (facets[i].2 as usize, facets[i + 1].2 as usize);
+                    // Elements on opposite sides list their shared facet in opposite orientations.
+                    if facets[i].1 == facets[i + 1].1 {
+                        return Err(MeshError::OverlappingElements { elements: [a / n, b / n] });
+                    }
                     neighbours[a] = (b / n) as u32;
                     neighbours[b] = (a / n) as u32;
                 }
@@ -83,12 +85,7 @@ impl FacetAdjacency {
     /// right-hand normal points out of the solid), in element order. Assumes positively oriented
     /// elements, as every [`Mesh`] has.
     pub fn oriented_boundary_facets<const D: usize>(&self, mesh: &Mesh<D>) -> Vec<[u32; D]> {
-        // The facet opposite local vertex `i`, listed so that it is outward for a positive simplex.
-        let local: &[&[usize]] = match D {
-            2 => &[&[1, 2], &[2, 0], &[0, 1]],
-            3 => &[&[1, 2, 3], &[0, 3, 2], &[0, 1, 3], &[0, 2, 1]],
-            _ => unreachable!("meshes are 2D or 3D"),
-        };
+        let local = outward_facets::<D>();
         self.boundary_facets()
             .map(|(e, opposite)| {
                 let cell = mesh.element(e);
@@ -114,6 +111,29 @@ impl FacetAdjacency {
     pub fn num_interior_facets(&self) -> usize {
         self.neighbours.iter().filter(|&&n| n != Self::BOUNDARY).count() / 2
     }
+}
+
+/// The facet opposite each local vertex `i`, listed so that it is outward for a positive simplex.
+fn outward_facets<const D: usize>() -> &'static [&'static [usize]] {
+    match D {
+        2 => &[&[1, 2], &[2, 0], &[0, 1]],
+        3 => &[&[1, 2, 3], &[0, 3, 2], &[0, 1, 3], &[0, 2, 1]],
+        _ => unreachable!("meshes are 2D or 3D"),
+    }
+}
+
+/// Sorts `values` (at most 3) and says whether that took an odd permutation.
+fn sort_parity(values: &mut [u32]) -> bool {
+    let mut odd = false;
+    for end in (1..values.len()).rev() {
+        for k in 0..end {
+            if values[k] > values[k + 1] {
+                values.swap(k, k + 1);
+                odd = !odd;
+            }
+        }
+    }
+    odd
 }
 
 #[cfg(test)]
@@ -169,5 +189,24 @@ mod tests {
         let v = vec![[0.0, 0.0], [1.0, 0.0], [0.5, 1.0], [0.5, -1.0], [0.5, 2.0]];
         let m = Mesh2::new_reoriented(v, vec![0, 1, 2, 0, 1, 3, 0, 1, 4]).unwrap();
         assert!(matches!(FacetAdjacency::new(&m), Err(MeshError::NonManifoldFacet { .. })));
+    }
+
+    #[test]
+    fn overlapping_elements_are_an_error() {
+        let square = || (vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![0, 1, 2, 0, 2, 3]);
+        let (v, mut cells) = square();
+        cells.extend([0, 1, 2]);
+        let twice = Mesh2::new(v, cells).unwrap();
+        assert!(matches!(FacetAdjacency::new(&twice), Err(MeshError::OverlappingElements { .. })));
+        // A triangle on edge (0, 1) whose apex lies inside triangle 0 overlaps it.
+        let (mut v, mut cells) = square();
+        v.push([0.6, 0.3]);
+        cells.extend([0, 1, 4]);
+        let inside = Mesh2::new(v, cells).unwrap();
+        assert!(matches!(FacetAdjacency::new(&inside), Err(MeshError::OverlappingElements { elements: [0, 2] })));
+        // In 3D: a tet and its copy with two vertices swapped back to positive orientation.
+        let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.1, 0.1, 0.5]];
+        let m = Mesh3::new_reoriented(v, vec![0, 1, 2, 3, 0, 1, 2, 4]).unwrap();
+        assert!(matches!(FacetAdjacency::new(&m), Err(MeshError::OverlappingElements { .. })));
     }
 }

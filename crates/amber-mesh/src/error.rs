@@ -24,6 +24,9 @@ pub enum MeshError {
     /// A facet is shared by more than two elements.
     #[error("facet {facet:?} is shared by more than two elements (non-manifold mesh)")]
     NonManifoldFacet { facet: Vec<u32> },
+    /// Two elements share a facet from the same side.
+    #[error("elements {} and {} overlap: they lie on the same side of their shared facet", elements[0], elements[1])]
+    OverlappingElements { elements: [usize; 2] },
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },

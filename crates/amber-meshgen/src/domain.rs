@@ -131,8 +131,8 @@ impl PolygonDomain {
     }
 
     fn validate(&self) -> Result<(), MeshgenError> {
-        // Squared lengths of edges between such points stay finite.
-        const MAX_COORDINATE: f64 = 1e150;
+        // The range of spade's exact predicates (also where squared lengths stay finite).
+        const MAX_COORDINATE: f64 = spade::MAX_ALLOWED_VALUE;
         let invalid = |msg: String| Err(MeshgenError::InvalidDomain(msg));
         for (r, ring) in self.rings().enumerate() {
             if ring.len() < 3 {
@@ -143,7 +143,15 @@ impl PolygonDomain {
             }
             if let Some(i) = ring.iter().position(|p| p[0].abs().max(p[1].abs()) > MAX_COORDINATE) {
                 return invalid(format!(
-                    "ring {r}, vertex {i} lies beyond ±{MAX_COORDINATE:e}, where edge lengths and areas overflow"
+                    "ring {r}, vertex {i} lies beyond ±{MAX_COORDINATE:e}, where the triangulation's exact predicates overflow"
+                ));
+            }
+            if let Some(i) = ring.iter().position(|p| p.iter().any(|&c| c != 0.0 && c.abs() < spade::MIN_ALLOWED_VALUE))
+            {
+                return invalid(format!(
+                    "ring {r}, vertex {i} has a coordinate nearer 0 than ±{:e}, where the triangulation's exact \
+                     predicates underflow",
+                    spade::MIN_ALLOWED_VALUE
                 ));
             }
             for i in 0..ring.len() {
@@ -381,10 +389,12 @@ mod tests {
         assert!(matches!(PolygonDomain::new(repeated, vec![]), Err(MeshgenError::InvalidDomain(_))));
         let nan = vec![[0.0, 0.0], [1.0, f64::NAN], [0.0, 1.0]];
         assert!(matches!(PolygonDomain::new(nan, vec![]), Err(MeshgenError::InvalidDomain(_))));
-        let overflowing = vec![[0.0, 0.0], [1e200, 0.0], [1e200, 1e200], [0.0, 1e200]];
-        assert!(
-            matches!(PolygonDomain::new(overflowing, vec![]), Err(MeshgenError::InvalidDomain(m)) if m.contains("overflow"))
-        );
+        // Beyond spade's range (the probe's 1e149 domain failed inside the triangulation).
+        for (far, says) in [(1e149, "overflow"), (1e-50, "underflow")] {
+            let square = vec![[0.0, 0.0], [far, 0.0], [far, far], [0.0, far]];
+            let err = PolygonDomain::new(square, vec![]);
+            assert!(matches!(err, Err(MeshgenError::InvalidDomain(ref m)) if m.contains(says)), "{far}: {err:?}");
+        }
         let big = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]].to_vec();
         let hole = [[1.0, 1.0], [9.0, 1.0], [9.0, 9.0], [1.0, 9.0]].to_vec();
         let inner = [[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]].to_vec();

@@ -27,6 +27,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::TaskError;
+use crate::expert::extent_mismatch;
 use crate::part::{
     FEATURE_ANGLE_DEGREES, PART_INPUTS_SUFFIX, PartInputs, PlanarPart, SolidPart, polygon_domain_of_mesh,
     read_polygon_domain, read_solid_surface, solid_surface_of_mesh,
@@ -46,17 +47,6 @@ pub const GEOMETRY_DIR: &str = "reference_surface";
 /// Console's 15 paper training parts (median expert size 1.23 mm) the rule gives 4.92 mm, near
 /// the spec's h₀ = 4.3955 mm, which the Console experiment passes explicitly.
 pub const INITIAL_SIZE_FACTOR: f64 = 4.0;
-
-/// Geometry and mesh may enclose volumes (areas) differing by this fraction: a geometry file of
-/// another part, or in other units, differs by far more; a faceted CAD surface and its mesh by
-/// far less.
-const VOLUME_TOLERANCE: f64 = 0.01;
-
-/// The corners of the geometry's and the mesh's bounding boxes may lie this fraction of the
-/// mesh's box diagonal apart: a part of about the same volume placed elsewhere or shaped
-/// otherwise moves them by far more, while Console's expert meshes and their reference
-/// surfaces differ by at most 0.19 % (train/006).
-const BOX_TOLERANCE: f64 = 0.01;
 
 /// A split of a dataset folder.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -305,31 +295,13 @@ fn check_geometry<const D: usize>(
     volume: f64,
 ) -> Result<(), TaskError> {
     let Some(path) = &expert.geometry else { return Ok(()) };
-    let mismatch = |what: String| {
-        let message = format!("{what}: not the geometry of the expert mesh {}", expert.path.display());
-        Err(TaskError::Dataset { path: path.clone(), message })
-    };
-    let mesh_volume = expert.mesh.total_volume();
-    if (volume / mesh_volume - 1.0).abs() > VOLUME_TOLERANCE {
-        let what = if D == 3 { "volume" } else { "area" };
-        return mismatch(format!("encloses {what} {volume:.6e}, but the mesh covers {mesh_volume:.6e}"));
+    match extent_mismatch(bounds, volume, &expert.mesh) {
+        Some(what) => {
+            let message = format!("{what}: not the geometry of the expert mesh {}", expert.path.display());
+            Err(TaskError::Dataset { path: path.clone(), message })
+        }
+        None => Ok(()),
     }
-    let Some(mesh_bounds) = expert.mesh.bounding_box() else { return Ok(()) };
-    let diagonal = (0..D).map(|k| (mesh_bounds.1[k] - mesh_bounds.0[k]).powi(2)).sum::<f64>().sqrt();
-    let offset = (0..D)
-        .map(|k| (bounds.0[k] - mesh_bounds.0[k]).abs().max((bounds.1[k] - mesh_bounds.1[k]).abs()))
-        .fold(0.0, f64::max);
-    if offset > BOX_TOLERANCE * diagonal {
-        return mismatch(format!(
-            "bounding box {:?}–{:?} is {offset:.4e} away from the mesh's {:?}–{:?} (tolerance {:.4e})",
-            bounds.0,
-            bounds.1,
-            mesh_bounds.0,
-            mesh_bounds.1,
-            BOX_TOLERANCE * diagonal
-        ));
-    }
-    Ok(())
 }
 
 /// The error of an M⁰ that could not be meshed.
@@ -379,7 +351,7 @@ pub fn problems<const D: usize, P: FolderDomain<D>>(
         .into_par_iter()
         .map(|expert| {
             let domain = P::from_expert(&expert, initial_size, settings)?;
-            Ok(WithExpert { domain, expert_mesh: expert.mesh })
+            WithExpert::new(domain, expert.mesh, &expert.path)
         })
         .collect::<Result<_, TaskError>>()?;
     // A model reads the same inputs on every part.

@@ -14,6 +14,7 @@
 
 pub mod console;
 mod error;
+mod expert;
 pub mod folder;
 pub mod part;
 pub mod poisson;

@@ -7,6 +7,8 @@
 //! requested element count ([`mesh_to_element_count`]). Each task implements the traits beside
 //! its data (`poisson`, `console`); geometry-only domains live in `part`.
 
+use std::path::Path;
+
 use amber_fem::FemError;
 use amber_graph::{Aggregation, ElementColumn, FeatureSet, GraphError, MeshGraph, NodeFeature, project_expert_sizing};
 use amber_mesh::Mesh;
@@ -14,6 +16,9 @@ use amber_meshgen::{MeshgenError, estimated_element_count};
 use amber_metrics::MetricsError;
 use amber_stdx::quantile;
 use serde::{Deserialize, Serialize};
+
+use crate::TaskError;
+use crate::expert::check_expert_mesh;
 
 /// Why one problem's step failed.
 #[derive(Debug, thiserror::Error)]
@@ -65,6 +70,9 @@ pub trait Domain<const D: usize>: Sync {
 pub trait Problem<const D: usize>: Domain<D> {
     /// M*, the expert's mesh the labels come from.
     fn expert_mesh(&self) -> &Mesh<D>;
+    /// The problem's name for people and result files: its expert mesh file's stem, or the
+    /// seed of a generated problem.
+    fn name(&self) -> String;
 }
 
 /// A domain with an expert's mesh of it: a [`Problem`] put together from its parts, e.g. a user's
@@ -73,6 +81,18 @@ pub trait Problem<const D: usize>: Domain<D> {
 pub struct WithExpert<P, const D: usize> {
     pub domain: P,
     pub expert_mesh: Mesh<D>,
+    /// The stem of the expert mesh's file.
+    name: String,
+}
+
+impl<const D: usize, P: Domain<D>> WithExpert<P, D> {
+    /// `domain` with `expert_mesh`, read from `path`, checked to be a mesh of it: conforming,
+    /// covering M⁰'s region and no more, without holes M⁰ lacks.
+    pub fn new(domain: P, expert_mesh: Mesh<D>, path: &Path) -> Result<Self, TaskError> {
+        check_expert_mesh(path, &expert_mesh, domain.initial_mesh())?;
+        let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
+        Ok(Self { domain, expert_mesh, name })
+    }
 }
 
 impl<const D: usize, P: Domain<D>> Domain<D> for WithExpert<P, D> {
@@ -100,6 +120,10 @@ impl<const D: usize, P: Domain<D>> Domain<D> for WithExpert<P, D> {
 impl<const D: usize, P: Domain<D>> Problem<D> for WithExpert<P, D> {
     fn expert_mesh(&self) -> &Mesh<D> {
         &self.expert_mesh
+    }
+
+    fn name(&self) -> String {
+        self.name.clone()
     }
 }
 

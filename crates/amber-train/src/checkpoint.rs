@@ -114,6 +114,11 @@ pub struct AdditionCounts {
     pub failed: u64,
 }
 
+/// The largest next buffer entry id a state may hold: a run adds a few entries per step, so no
+/// run reaches 2⁵³ (its ids stay exact in JSON readers that use f64), and ids far below 2⁶⁴
+/// cannot wrap around to collide with the protected entries.
+const MAX_ENTRY_ID: u64 = 1 << 53;
+
 /// `state.json`: everything of a run that is neither the network, the optimiser moments, the
 /// predictor nor an entry payload.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -133,8 +138,15 @@ pub(crate) struct TrainingState {
 
 impl TrainingState {
     /// Checks what the file says against itself and the run's `problems` training problems:
-    /// entry ids unique and below the next id, problem indices in range.
+    /// entry ids unique and below the next id, the next id far from wrapping, problem indices in
+    /// range.
     pub(crate) fn check(&self, problems: usize) -> std::result::Result<(), String> {
+        if self.next_entry_id > MAX_ENTRY_ID {
+            return Err(format!(
+                "next_entry_id {} is above {MAX_ENTRY_ID}, more entries than a run adds",
+                self.next_entry_id
+            ));
+        }
         let entries = || self.protected.iter().chain(&self.generated);
         let mut ids = HashSet::new();
         for e in entries() {
@@ -354,6 +366,7 @@ mod tests {
         };
         assert!(state(2, vec![entry(0, 1)]).check(2).is_ok());
         assert!(state(0, vec![entry(0, 1)]).check(2).unwrap_err().contains("next_entry_id"), "wrapped id");
+        assert!(state(u64::MAX, vec![entry(0, 1)]).check(2).unwrap_err().contains("above"), "id about to wrap");
         assert!(state(2, vec![entry(1, 1)]).check(2).is_err(), "repeated id");
         assert!(state(2, vec![entry(0, 5)]).check(2).unwrap_err().contains("problem 5"));
     }

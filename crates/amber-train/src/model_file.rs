@@ -142,6 +142,8 @@ mod tests {
         let json = |pointer: &'static str, value: Value, needle: &str| {
             assert_rejected(amber_model, load, PREDICTOR_FILE, needle, |f| set_json(f, pointer, value));
         };
+        json("/features/node", json!([]), "features.node: 0 node features, but the network (model.json) reads 1");
+        json("/features/edge", json!([]), "features.edge: 0 or 0 columns");
         json("/normaliser/node/var/0", json!(-1.0), "normaliser.node: variance of column 0 is -1");
         json("/normaliser/edge/count", json!(0.0), "normaliser.edge: count 0");
         json("/normaliser/node/mean", json!([0.0, 0.0]), "normaliser.node: 2 means but 1 variances");

@@ -459,7 +459,7 @@ mod tests {
                 let domain = domain.unwrap();
                 let mesh = domain.initial_mesh().clone();
                 let expert_mesh = domain.remesh(&mesh, vec![0.04; mesh.num_elements()], 1_000_000).unwrap();
-                WithExpert { domain, expert_mesh }
+                WithExpert::new(domain, expert_mesh, std::path::Path::new("square.json")).unwrap()
             })
             .collect();
         let limits =

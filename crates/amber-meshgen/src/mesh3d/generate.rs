@@ -148,6 +148,15 @@ pub fn adapt_surface(
         validated = copy;
         &validated
     };
+    // A field over the cap is refused before any work (once one size is known to be valid); 2×
+    // leaves room for the estimate's error, as in 2D.
+    checked_size(field, reference.vertices()[0])?;
+    if let Some(n) = field.estimated_elements(reference.enclosed_volume()) {
+        let n = n / params.size_factor.powi(3);
+        if !n.is_finite() || n > 2.0 * params.max_elements as f64 {
+            return Err(Mesh3dError::TooManyElements { cap: params.max_elements, estimated: n.min(1e18) as usize });
+        }
+    }
     let field = CurvatureCappedField::new(reference, field, params.size_factor, params.curvature_tolerance);
     // A closed surface of T triangles bounds at least T/4 tets: more triangles than 4·cap
     // cannot make an acceptable mesh.

@@ -30,12 +30,13 @@ struct DomainFile {
     holes: Vec<Vec<[f64; 2]>>,
 }
 
-/// A problem file read as a part: the expert mesh is ignored and M⁰ optional.
+/// A problem file read as a part: M⁰ and the expert mesh are optional.
 #[derive(Deserialize)]
 struct PartFile {
     domain: DomainFile,
     load: GaussianMixture,
     initial_mesh: Option<MeshFile>,
+    mesh: Option<MeshFile>,
     #[serde(default)]
     metadata: ProblemMetadata,
 }
@@ -103,19 +104,21 @@ pub fn read_problem(path: &Path) -> Result<PoissonProblem, TaskError> {
 }
 
 /// Reads a problem file (ours or the reference's) as a [`PoissonPart`]: its domain (any polygon,
-/// with optional `domain.holes`), load and, when present, initial mesh; an expert `mesh` is not
-/// needed and not read.
-pub fn read_part(path: &Path) -> Result<PoissonPart, TaskError> {
+/// with optional `domain.holes`), load and, when present, initial mesh; with the expert `mesh`
+/// when the file has one (checked as the problem's meshes are, not yet against the domain).
+pub fn read_part(path: &Path) -> Result<(PoissonPart, Option<Mesh2>), TaskError> {
     let bytes = std::fs::read(path).map_err(|source| TaskError::Io { path: path.into(), source })?;
     let file: PartFile =
         serde_json::from_slice(&bytes).map_err(|source| TaskError::Json { path: path.into(), source })?;
     let domain = amber_meshgen::PolygonDomain::new(file.domain.polygon, file.domain.holes)
         .map_err(|e| TaskError::Polygon { path: path.into(), message: e.to_string() })?;
     let initial_mesh = file.initial_mesh.map(|m| m.into_mesh(path, "initial_mesh")).transpose()?;
+    let expert_mesh = file.mesh.map(|m| m.into_mesh(path, "mesh")).transpose()?;
     let order =
         file.metadata.heuristic.map_or(amber_fem::ExpertHeuristic::default().quadrature_order, |h| h.quadrature_order);
-    PoissonPart::new(domain, file.load, initial_mesh, order)
-        .map_err(|e| TaskError::Polygon { path: path.into(), message: format!("initial mesh: {e}") })
+    let part = PoissonPart::new(domain, file.load, initial_mesh, order)
+        .map_err(|e| TaskError::Polygon { path: path.into(), message: format!("initial mesh: {e}") })?;
+    Ok((part, expert_mesh))
 }
 
 /// Reads every problem file (`*.json`, ours or the reference's format) of a directory in name

@@ -57,6 +57,10 @@ impl Problem<2> for PoissonProblem {
     fn expert_mesh(&self) -> &Mesh<2> {
         &self.expert_mesh
     }
+
+    fn name(&self) -> String {
+        self.metadata.seed.map_or_else(|| "a problem without a seed".into(), |seed| format!("seed {seed}"))
+    }
 }
 
 /// The Poisson task on any polygon with holes, without an expert: −Δu = f with u = 0 on the

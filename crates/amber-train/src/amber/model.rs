@@ -39,10 +39,26 @@ impl Predictor {
         read_checked(path, |p: &Self| p.validate(network))
     }
 
-    /// Checks what a file could get wrong: the normaliser and the target moments (finite,
+    /// Checks what a file could get wrong: the features (as many node and edge columns as the
+    /// network reads, edges of a 2D or 3D mesh), the normaliser and the target moments (finite,
     /// non-negative variances, positive counts, one column per network input or one target) and
     /// the limits (positive).
     fn validate(&self, network: &MpnConfig) -> Result<(), String> {
+        if self.features.node_dim() != network.node_features {
+            return Err(format!(
+                "features.node: {} node features, but the network (model.json) reads {}",
+                self.features.node_dim(),
+                network.node_features
+            ));
+        }
+        if ![2, 3].into_iter().any(|d| self.features.edge_dim(d) == network.edge_features) {
+            return Err(format!(
+                "features.edge: {} or {} columns in 2D or 3D, but the network (model.json) reads {}",
+                self.features.edge_dim(2),
+                self.features.edge_dim(3),
+                network.edge_features
+            ));
+        }
         if let Some(n) = &self.normaliser {
             check_moments("normaliser.node", &n.node, network.node_features)?;
             check_moments("normaliser.edge", &n.edge, network.edge_features)?;

@@ -387,6 +387,10 @@ mod tests {
         fn expert_mesh(&self) -> &Mesh3 {
             &self.expert
         }
+
+        fn name(&self) -> String {
+            "cube".into()
+        }
     }
 
     impl Domain<3> for CubeProblem {
