@@ -4,17 +4,18 @@
 //! shapes in the same session.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 
 use amber_cnn::UNetConfig;
 use amber_cnn::bench::BenchCase;
 use amber_stdx::median;
 use amber_train::CnnConfig;
-use anyhow::{Context, bail};
+use anyhow::Context;
 use serde_json::{Value, json};
 
+use crate::peer::{Peer, PeerDir};
 use crate::report;
+use crate::timing::load_average;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -166,33 +167,18 @@ fn time(args: &Args, step: &mut dyn FnMut() -> anyhow::Result<()>) -> anyhow::Re
         .collect()
 }
 
-/// `/proc/loadavg`: how busy the shared machine was around a measurement.
-fn load_average() -> Option<String> {
-    std::fs::read_to_string("/proc/loadavg").ok().map(|s| s.trim().to_string())
-}
-
 /// Runs the PyTorch peer with the case's input channels and returns its case of the same
 /// dimension (the script times both dimensions with one channel count).
 fn run_peer(python: &Path, case: &Case, args: &Args) -> anyhow::Result<Value> {
-    let results = std::env::temp_dir().join(format!("amber-peer-unet-{}-{}", case.name, std::process::id()));
-    let status = Command::new(python)
-        .arg(&args.peer_script)
-        .args(["--channels", &case.in_channels.to_string()])
-        .env("PEERS_RESULTS", &results)
-        .env("PEERS_THREADS", args.threads.to_string())
-        .env("PEERS_OMP_WAIT_POLICY", "PASSIVE")
-        .env("PEERS_REPEATS", args.iters.max(1).to_string())
+    let peer = Peer { python, threads: args.threads };
+    let env = [
+        ("PEERS_REPEATS", args.iters.max(1).to_string()),
         // The peer waits (bounded) for a quiet machine before timing; a shared machine may never be.
-        .env("PEERS_MAX_WAIT", "10")
-        .status()
-        .with_context(|| format!("running {} {}", python.display(), args.peer_script.display()))?;
-    if !status.success() {
-        bail!("the peer benchmark failed: {status}");
-    }
-    let path = results.join("unet.json");
-    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    std::fs::remove_dir_all(&results).ok();
-    let mut all: Value = serde_json::from_str(&text)?;
+        ("PEERS_MAX_WAIT", "10".to_string()),
+    ];
+    let dir = PeerDir::new(&format!("unet-{}", case.name))?;
+    let channels = case.in_channels.to_string();
+    let mut all = peer.run(&args.peer_script, &["--channels", &channels], &env, &dir, "unet.json")?;
     let cases = all["cases"].as_array_mut().context("peer result without cases")?;
     let index = cases
         .iter()

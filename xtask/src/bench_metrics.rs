@@ -6,9 +6,11 @@
 //!   (target ≤ 50 ms), and, for information, the reverse direction, where every element of the
 //!   finer current mesh falls back to point location in the expert.
 //!
-//! Reference in the same run: each case again on one thread (the ratio is the parallel speed-up).
+//! Reference in the same run: each case again on one thread (the ratio is the parallel speed-up),
+//! and with `--peer-python`, the DCD case computed with pykdtree on the same points
+//! (`xtask/peers/bench_metrics.py`, the reference code's way, on `--threads` threads).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use amber_graph::{Aggregation, project_expert_sizing};
@@ -18,8 +20,10 @@ use amber_stdx::median;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use serde::Serialize;
+use serde_json::{Value, json};
 
-use crate::timing::{CpuClock, cpu_seconds};
+use crate::peer::{Peer, PeerDir};
+use crate::timing::{CpuClock, Load, LoadMeter, cpu_seconds};
 
 #[derive(clap::Args, Debug, Serialize)]
 pub struct Args {
@@ -44,6 +48,9 @@ pub struct Args {
     /// Seed of the random point sets.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Python with pykdtree and numpy: also time the peer on the DCD case.
+    #[arg(long)]
+    peer_python: Option<PathBuf>,
 }
 
 #[derive(Serialize)]
@@ -62,6 +69,14 @@ struct Case {
     cpu_s: Option<f64>,
     /// The computed value, to catch a benchmark that measures nothing.
     checksum: f64,
+    /// The same work in the peer library, in the same run (with `--peer-python`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    peer: Option<Value>,
+    /// The peer's median wall time over ours on `threads` threads (above 1: ours is faster).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    peer_time_over_ours: Option<f64>,
+    /// The machine around ours and the peer.
+    load: Load,
 }
 
 #[derive(Serialize)]
@@ -82,9 +97,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let current = unit_square(args.current_squares)?;
 
     let mut cases = Vec::new();
-    cases.push(time_case(&args, format!("dcd_2d_{}_vs_{}", args.points, args.points), Some(1.0), || {
+    let meter = LoadMeter::start();
+    let mut dcd = time_case(&args, format!("dcd_2d_{}_vs_{}", args.points, args.points), Some(1.0), || {
         Ok(point_set_distance(&a, &b)?.dcd)
-    })?);
+    })?;
+    if let Some(python) = &args.peer_python {
+        let peer = run_dcd_peer(python, &a, &b, &args)?;
+        dcd.peer_time_over_ours = peer["seconds"].as_f64().map(|p| p / dcd.median_s);
+        dcd.peer = Some(peer);
+        // The load around ours and the peer.
+        dcd.load = meter.finish();
+    }
+    cases.push(dcd);
     cases.push(time_case(
         &args,
         format!("projection_mean_{}_onto_{}", expert.num_elements(), current.num_elements()),
@@ -109,6 +133,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "{:<48} {:>9.4} s  (1 thread {:>8.4} s, speed-up {:.2}×{cpu})  {verdict}",
             c.name, c.median_s, c.single_thread_median_s, c.speedup
         );
+        if let (Some(p), Some(ratio)) = (&c.peer, c.peer_time_over_ours) {
+            println!(
+                "{:<48} {:>9.4} s  (value {:.12}, ours {:.12}) → peer/ours {ratio:.2}× [other CPUs {:.2}]",
+                format!("  {}", p["library"].as_str().unwrap_or("peer")),
+                p["seconds"].as_f64().unwrap_or(f64::NAN),
+                p["dcd"].as_f64().unwrap_or(f64::NAN),
+                c.checksum,
+                c.load.other_cpus
+            );
+        }
     }
     let report = Report { benchmark: "metrics", settings: &args, machine: crate::report::machine(), cases };
     crate::report::write_json(&args.out, &report)
@@ -121,6 +155,7 @@ fn time_case(
     target_s: Option<f64>,
     work: impl Fn() -> anyhow::Result<f64> + Sync,
 ) -> anyhow::Result<Case> {
+    let meter = LoadMeter::start();
     let median_on = |threads: usize| -> anyhow::Result<Timing> {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         let checksum = pool.install(&work)?;
@@ -147,7 +182,19 @@ fn time_case(
         speedup: single_thread_median_s / median_s,
         cpu_s,
         checksum,
+        peer: None,
+        peer_time_over_ours: None,
+        load: meter.finish(),
     })
+}
+
+/// Runs pykdtree's DCD on the same point sets (`xtask/peers/bench_metrics.py`).
+fn run_dcd_peer(python: &Path, first: &[[f64; 2]], second: &[[f64; 2]], args: &Args) -> anyhow::Result<Value> {
+    let dir = PeerDir::new("metrics")?;
+    dir.write_npy("first", &[first.len(), 2], first.as_flattened())?;
+    dir.write_npy("second", &[second.len(), 2], second.as_flattened())?;
+    dir.write_input(&json!({ "repeats": args.repeats }))?;
+    Peer { python, threads: args.threads }.run_script("bench_metrics.py", &dir)
 }
 
 struct Timing {

@@ -3,7 +3,6 @@
 //! next to the PyTorch peer (`shared/peers/bench_mpn.py`) run on a graph of the same size.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 
 use amber_mpn::MpnConfig;
@@ -13,7 +12,8 @@ use amber_train::TrainingConfig;
 use anyhow::{Context, bail};
 use serde_json::{Value, json};
 
-use crate::timing::{CLOCK_TICKS_PER_S, CpuClock, CpuTimer};
+use crate::peer::{Peer, PeerDir};
+use crate::timing::{CpuClock, CpuTimer, LoadMeter};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -133,11 +133,11 @@ fn bench_case(
     }
     let (mut times, mut cpu, mut others) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..args.iters.max(1) {
-        let load = CpuLoad::start();
+        let (load, own) = (LoadMeter::start(), CpuTimer::start(CpuClock::Process));
         let t = Instant::now();
         step()?;
         times.push(t.elapsed().as_secs_f64());
-        cpu.push(load.own_cpu_s());
+        cpu.push(own.seconds());
         others.push(load.other_cpus());
     }
     let s_median = median(&times);
@@ -168,63 +168,15 @@ fn peak_rss_gib() -> Option<f64> {
     Some(kib / (1024.0 * 1024.0))
 }
 
-/// CPUs used by other processes while a case runs: the machine's busy time from `/proc/stat`
-/// minus this process's own CPU time, as in the peer benchmarks.
-struct CpuLoad {
-    busy: u64,
-    total: u64,
-    own: CpuTimer,
-}
-
-impl CpuLoad {
-    /// The machine's busy and total clock ticks so far.
-    fn machine_ticks() -> Option<(u64, u64)> {
-        let stat = std::fs::read_to_string("/proc/stat").ok()?;
-        let v: Vec<u64> = stat.lines().next()?.split_whitespace().skip(1).filter_map(|x| x.parse().ok()).collect();
-        let total: u64 = v.iter().sum();
-        Some((total - v.get(3)? - v.get(4)?, total))
-    }
-
-    fn start() -> Self {
-        let (busy, total) = Self::machine_ticks().unwrap_or_default();
-        Self { busy, total, own: CpuTimer::start(CpuClock::Process) }
-    }
-
-    /// CPU seconds (user + system, all threads) this process used since `start`.
-    fn own_cpu_s(&self) -> f64 {
-        self.own.seconds()
-    }
-
-    fn other_cpus(&self) -> f64 {
-        let Some((busy, total)) = Self::machine_ticks() else {
-            return f64::NAN;
-        };
-        let cpus = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
-        let other = (busy - self.busy) as f64 / CLOCK_TICKS_PER_S - self.own.seconds();
-        (other / ((total - self.total).max(1) as f64 / CLOCK_TICKS_PER_S) * cpus).max(0.0)
-    }
-}
-
 /// Runs the PyTorch peer (plain and PyG aggregation) on a graph of the same size, with self-loops,
 /// and returns its JSON.
 fn run_peer(python: &Path, args: &Args) -> anyhow::Result<Value> {
-    let results = std::env::temp_dir().join(format!("amber-peer-mpn-{}", std::process::id()));
-    let status = Command::new(python)
-        .arg(&args.peer_script)
-        .args(["--sizes", &args.nodes.to_string(), "--variants", "plain,pyg", "--ckpt-sizes", "", "--self-loops"])
-        .args(["--steps", &args.iters.to_string()])
-        .env("PEERS_RESULTS", &results)
-        .env("PEERS_THREADS", args.peer_threads.to_string())
-        .env("PEERS_OMP_WAIT_POLICY", "PASSIVE")
-        .status()
-        .with_context(|| format!("running {} {}", python.display(), args.peer_script.display()))?;
-    if !status.success() {
-        bail!("the peer benchmark failed: {status}");
-    }
-    let path = results.join("mpn.json");
-    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    std::fs::remove_dir_all(&results).ok();
-    Ok(serde_json::from_str(&text)?)
+    let sizes = args.nodes.to_string();
+    let steps = args.iters.to_string();
+    let peer_args =
+        ["--sizes", &sizes, "--variants", "plain,pyg", "--ckpt-sizes", "", "--self-loops", "--steps", &steps];
+    let peer = Peer { python, threads: args.peer_threads };
+    peer.run(&args.peer_script, &peer_args, &[], &PeerDir::new("mpn")?, "mpn.json")
 }
 
 /// Speed-ups of the fused variant over the naive one and over each peer case.

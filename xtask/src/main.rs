@@ -11,6 +11,7 @@ mod bench_metrics;
 mod bench_mpn;
 mod dataset;
 mod label_rollouts;
+mod peer;
 mod plan;
 mod reference_distances;
 mod report;
