@@ -295,7 +295,7 @@ def results_fields(path):
     runs = r.get("runs") or [{}]
     if not all(run.get("problems") for run in runs):
         missing.append("per-problem values")
-    if "hash" not in text:
+    if not all(run.get("test_data_sha256") for run in runs):
         missing.append("the data's hash")
     names = all(any(k in p for k in ("name", "file", "path", "seed")) for run in runs for p in run.get("problems", []))
     extra = "" if names else "; per-problem entries name no problem"
