@@ -68,7 +68,12 @@ pub fn mesh_sha256<const D: usize>(mesh: &Mesh<D>) -> String {
         v.iter().for_each(|c| hasher.update(c.to_le_bytes()));
     }
     mesh.cells().iter().for_each(|c| hasher.update(c.to_le_bytes()));
-    hasher.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    hex(&hasher.finalize())
+}
+
+/// Lower-case hex of a digest.
+fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// One trained and evaluated configuration: the means over the test problems.
@@ -134,12 +139,11 @@ impl RunResult {
             difficulty: key.difficulty.into(),
             seed: key.seed,
             test_problems: problems.len(),
-            test_data_sha256: problems.iter().map(|p| p.expert_sha256.as_deref()).collect::<Option<Vec<_>>>().map(
-                |hashes| {
-                    let digest = Sha256::digest(hashes.concat().as_bytes());
-                    digest.iter().map(|b| format!("{b:02x}")).collect()
-                },
-            ),
+            test_data_sha256: problems
+                .iter()
+                .map(|p| p.expert_sha256.as_deref())
+                .collect::<Option<Vec<_>>>()
+                .map(|hashes| hex(&Sha256::digest(hashes.concat().as_bytes()))),
             ndcd: mean(&|p| p.last().normalised_dcd),
             ndcd_quantiles: [quantile(&finals, 0.25), quantile(&finals, 0.75)],
             ndcd_per_step: (0..steps).map(|t| mean(&|p| p.steps[t].metrics.normalised_dcd)).collect(),
