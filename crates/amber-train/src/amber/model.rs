@@ -39,10 +39,21 @@ impl Predictor {
         read_checked(path, |p: &Self| p.validate(network))
     }
 
-    /// Checks what a file could get wrong: the normaliser and the target moments (finite,
-    /// non-negative variances, positive counts, one column per network input or one target) and
-    /// the limits (positive).
+    /// Checks what a file could get wrong: the features (one node column per network input, and
+    /// the edge columns of a 2D or a 3D mesh the network takes), the normaliser and the target
+    /// moments (finite, non-negative variances, positive counts, one column per network input or
+    /// one target) and the limits (positive).
     fn validate(&self, network: &MpnConfig) -> Result<(), String> {
+        let (node, edge) = (self.features.node_dim(), [2, 3].map(|dim| self.features.edge_dim(dim)));
+        if node != network.node_features {
+            return Err(format!("features.node: {node} columns, the network takes {}", network.node_features));
+        }
+        if !edge.contains(&network.edge_features) {
+            return Err(format!(
+                "features.edge: {} columns in 2D and {} in 3D, the network takes {}",
+                edge[0], edge[1], network.edge_features
+            ));
+        }
         if let Some(n) = &self.normaliser {
             check_moments("normaliser.node", &n.node, network.node_features)?;
             check_moments("normaliser.edge", &n.edge, network.edge_features)?;
