@@ -66,12 +66,28 @@ impl CardEvaluation {
 }
 
 impl ModelCard {
-    /// Reads the card of the model directory `dir`.
+    /// Reads the card of the model directory `dir`: at least one and at most
+    /// `TrainingConfig::MAX_INFERENCE_STEPS` generation steps and a positive M⁰ size, or an error
+    /// naming the card (`amber mesh` takes both from it).
     pub fn read(dir: &Path) -> anyhow::Result<Self> {
         let path = dir.join(CARD_FILE);
-        read_json(&path).with_context(|| {
+        let card: Self = read_json(&path).with_context(|| {
             format!("{}: the model has no readable card (models trained before cards existed need one)", path.display())
-        })
+        })?;
+        card.validate().map_err(|message| anyhow::anyhow!("{}: {message}", path.display()))?;
+        Ok(card)
+    }
+
+    /// What a card could get wrong that the model's use would only meet far from the file.
+    fn validate(&self) -> Result<(), String> {
+        let max_steps = amber_train::TrainingConfig::MAX_INFERENCE_STEPS;
+        if !(1..=max_steps).contains(&self.inference_steps) {
+            return Err(format!("inference_steps is {}, not in 1..={max_steps}", self.inference_steps));
+        }
+        if !(self.initial_size.is_finite() && self.initial_size > 0.0) {
+            return Err(format!("initial_size is {}, not a positive size", self.initial_size));
+        }
+        Ok(())
     }
 
     /// Writes the card into the model directory `dir`.
@@ -101,4 +117,44 @@ pub fn resolve_model(model: &str, shipped: &Path) -> anyhow::Result<PathBuf> {
         shipped.display(),
         if names.is_empty() { "none".to_owned() } else { names.join(", ") }
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn card() -> ModelCard {
+        ModelCard {
+            task: Task::Poisson,
+            method: "amber-mean".into(),
+            inference_steps: 5,
+            initial_size: 0.94667,
+            command: "amber train".into(),
+            data: "data/poisson".into(),
+            commit: "5952202".into(),
+            training_seconds: 1.0,
+            evaluation: None,
+        }
+    }
+
+    #[test]
+    fn cards_without_a_step_or_a_positive_initial_size_are_rejected_naming_the_card() {
+        // The fuzz inputs fuzz/corpus/model_dir/crash-card-*: `amber mesh` blamed a card with 0
+        // steps on `--steps`, and a negative M⁰ size on the geometry.
+        let dir = tempfile::tempdir().unwrap();
+        card().write(dir.path()).unwrap();
+        assert_eq!(ModelCard::read(dir.path()).unwrap(), card());
+        let path = dir.path().join(CARD_FILE).display().to_string();
+        let bad = [
+            (ModelCard { inference_steps: 0, ..card() }, "inference_steps is 0"),
+            (ModelCard { inference_steps: 10_001, ..card() }, "inference_steps is 10001"),
+            (ModelCard { initial_size: -1.0, ..card() }, "initial_size is -1"),
+            (ModelCard { initial_size: 0.0, ..card() }, "initial_size is 0"),
+        ];
+        for (card, needle) in bad {
+            card.write(dir.path()).unwrap();
+            let message = format!("{:#}", ModelCard::read(dir.path()).unwrap_err());
+            assert!(message.contains(&path) && message.contains(needle), "{message}");
+        }
+    }
 }

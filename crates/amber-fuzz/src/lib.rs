@@ -1,11 +1,19 @@
 //! The bodies of the fuzz targets: each takes arbitrary bytes, feeds them to one of amber's
 //! entry points for outside input (mesh files of every format, surface files, polygon domains
-//! and the meshers behind them), and panics only where amber broke a promise: a reader that
-//! panics, an error that does not name the file, a mesh that breaks the invariants its type
-//! guarantees, a mesher that exceeds its element cap. `fuzz/` wraps them for cargo-fuzz
-//! (libFuzzer, nightly); `tests/replay.rs` replays the committed corpus on stable in CI.
+//! and the meshers behind them here; Poisson problem files in `tasks`; model directories and
+//! training configurations in `train`), and panics only where amber broke a promise: a reader
+//! that panics, an error that does not name the file, a mesh that breaks the invariants its type
+//! guarantees, a mesher that exceeds its element cap, an accepted value outside the documented
+//! bounds. `fuzz/` wraps them for cargo-fuzz (libFuzzer); `tests/replay.rs` replays the
+//! committed corpus on stable in CI.
 
-use std::path::Path;
+mod tasks;
+mod train;
+
+pub use tasks::problem_file;
+pub use train::{model_dir, training_config};
+
+use std::path::{Path, PathBuf};
 
 use amber_mesh::{AnyMesh, Mesh, StlFaceIds, parse_any_mesh, parse_surface};
 use amber_meshgen::mesh3d::{Mesh3dParams, Surface, generate_3d};
@@ -15,14 +23,20 @@ use amber_meshgen::{ConstantSize, Mesh2dParams, PolygonDomain, uniform_mesh_2d};
 pub type Target = fn(data: &[u8]);
 
 /// Every target by name, as `fuzz/fuzz_targets/<name>.rs` and `fuzz/corpus/<name>/` know it.
-pub const TARGETS: [(&str, Target); 3] =
-    [("mesh_file", mesh_file), ("surface_file", surface_file), ("polygon_domain", polygon_domain)];
+pub const TARGETS: [(&str, Target); 6] = [
+    ("mesh_file", mesh_file),
+    ("surface_file", surface_file),
+    ("polygon_domain", polygon_domain),
+    ("problem_file", problem_file),
+    ("model_dir", model_dir),
+    ("training_config", training_config),
+];
 
 /// The extensions [`mesh_file`] chooses from with the input's first byte.
 const MESH_EXTENSIONS: [&str; 7] = ["msh", "vtu", "vtk", "nas", "inp", "mesh", "json"];
 
 /// Meshes made by the targets stay this small, so that an input runs in milliseconds.
-const ELEMENT_CAP: usize = 20_000;
+pub(crate) const ELEMENT_CAP: usize = 20_000;
 
 /// A mesh file: the first byte picks the format, the rest is the file. A mesh read is checked
 /// and its boundary made into a geometry (as a folder dataset without geometry files does).
@@ -86,13 +100,25 @@ pub fn polygon_domain(data: &[u8]) {
 }
 
 /// What `Mesh` promises: finite vertices, elements that index them, positive volumes.
-fn assert_valid<const D: usize>(mesh: &Mesh<D>) {
+pub(crate) fn assert_valid<const D: usize>(mesh: &Mesh<D>) {
     assert!(mesh.num_elements() > 0);
     assert!(mesh.vertices().iter().flatten().all(|x| x.is_finite()));
     assert!(mesh.volumes().iter().all(|&v| v > 0.0), "a non-positive element volume");
 }
 
 /// Errors about a file name it.
-fn assert_names(message: &str, path: &str) {
+pub(crate) fn assert_names(message: &str, path: &str) {
     assert!(message.contains(path), "error without the file name: {message}");
+}
+
+thread_local! {
+    /// The scratch directory of this thread, removed when a test's thread ends (libFuzzer exits
+    /// without running destructors and leaves its one directory behind).
+    static SCRATCH: tempfile::TempDir =
+        tempfile::Builder::new().prefix("amber-fuzz-").tempdir().expect("a temporary directory");
+}
+
+/// A directory of this thread for the targets whose readers take a path.
+pub(crate) fn scratch_dir() -> PathBuf {
+    SCRATCH.with(|dir| dir.path().to_owned())
 }

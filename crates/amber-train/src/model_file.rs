@@ -152,6 +152,17 @@ mod tests {
         json("/limits/min_size", json!(-0.5), "limits.min_size is -0.5");
         json("/limits/max_elements", json!(0), "limits.max_elements is 0");
         json("/limits/final_step_scale", json!(-2.0), "limits.final_step_scale is -2");
+        // The fuzz input fuzz/corpus/model_dir/crash-predictor-fewer-features-than-network: without
+        // a normaliser, a feature list cut short loaded and failed only in the first prediction,
+        // with a message naming no file.
+        let cut = |pointer: &'static str, needle: &str| {
+            assert_rejected(amber_model, load, PREDICTOR_FILE, needle, |f| {
+                set_json(f, "/normaliser", Value::Null);
+                set_json(f, pointer, json!([]));
+            });
+        };
+        cut("/features/node", "features.node: 0 node features, but the network (model.json) reads 1");
+        cut("/features/edge", "features.edge: 0 or 0 columns in 2D or 3D, but the network (model.json) reads 2");
         let weights = |name: &'static str, needle: &str, edit: fn(&mut Vec<usize>, &mut Vec<f32>)| {
             assert_rejected(amber_model, load, WEIGHTS_FILE, needle, |f| edit_tensor(f, name, edit));
         };
@@ -173,6 +184,11 @@ mod tests {
         json("/normaliser/count", json!(0.0), "normaliser: count 0");
         json("/label_moments/var", json!([1.0, 1.0]), "label_moments: 1 means but 2 variances");
         json("/resolution", json!(0), "resolution is 0");
+        // The fuzz inputs fuzz/corpus/model_dir/crash-cnn-resolution-*: a grid the U-Net cannot
+        // pool failed only in the first prediction, naming no file; a million pixels per axis
+        // meshed an auxiliary mesh for minutes.
+        json("/resolution", json!(17), "resolution is 17, not a positive multiple of 2");
+        json("/resolution", json!(1_000_000), "resolution is 1000000, at most 2048");
         json("/limits/min_size", json!(-1.0), "limits.min_size is -1");
         json("/limits/max_elements", json!(0), "limits.max_elements is 0");
         let weights = |name: &'static str, needle: &str, edit: fn(&mut Vec<usize>, &mut Vec<f32>)| {

@@ -1,7 +1,7 @@
 //! Every knob of an AMBER training run ([`TrainingConfig`]) and its named profiles.
 
 use amber_graph::Aggregation;
-use amber_mpn::NetworkConfig;
+use amber_mpn::{MpnConfig, NetworkConfig};
 use amber_nn::Objective;
 use serde::{Deserialize, Serialize};
 
@@ -84,6 +84,14 @@ impl Default for TrainingConfig {
 }
 
 impl TrainingConfig {
+    /// The most generation steps a rollout may take (`inference_steps`, and a model card's).
+    pub const MAX_INFERENCE_STEPS: usize = 10_000;
+
+    /// The most parameters the network may have ([`Self::network_parameters`]): 1.6 GB of
+    /// weights, gradients and Adam moments (the widest network, 1,024, at the default 10 steps
+    /// has 86 million).
+    pub const MAX_NETWORK_PARAMETERS: usize = 100_000_000;
+
     /// The paper's settings (spec §5, §6): Poisson hard, AMBER-Mean, softplus output with MSE on
     /// raw sizes, constant Adam 3e-4, clip 0.5, 400,000-node batches, 1,000-entry buffer with an
     /// addition every 8 steps, 128,000 steps, validation every 256-step iteration. Meant for a GPU
@@ -158,6 +166,14 @@ impl TrainingConfig {
         }
     }
 
+    /// Parameters of the configured network for the widest inputs a task gives it (node: the
+    /// Poisson task's four features and the configured inputs; edge: the 3D midpoint difference).
+    pub fn network_parameters(&self) -> usize {
+        let widest =
+            MpnConfig { node_features: 4 + self.inputs.len(), edge_features: 3, network: self.network.clone() };
+        widest.num_parameters()
+    }
+
     /// The config of a named profile.
     pub fn profile(profile: Profile) -> Self {
         match profile {
@@ -202,6 +218,10 @@ impl TrainingConfig {
         if self.data.train_problems == 0 {
             return bad("data.train_problems must be positive");
         }
+        if self.inference_steps == 0 {
+            // Validation would score M⁰ alone, and the model's card would hold no step to take.
+            return bad("inference_steps must be positive");
+        }
         // Upper bounds that a machine can hold, so that a typo is an error, not an abort.
         let limits: [(&str, u64, u64); 7] = [
             ("network.latent_dim", self.network.latent_dim as u64, 1_024),
@@ -210,10 +230,20 @@ impl TrainingConfig {
             ("buffer_capacity", self.buffer_capacity as u64, 1_000_000),
             ("data.train_problems", self.data.train_problems as u64, 100_000),
             ("data.val_problems", self.data.val_problems as u64, 100_000),
-            ("inference_steps", self.inference_steps as u64, 10_000),
+            ("inference_steps", self.inference_steps as u64, Self::MAX_INFERENCE_STEPS as u64),
         ];
         if let Some((field, value, max)) = limits.into_iter().find(|&(_, value, max)| value > max) {
             return Err(TrainError::InvalidConfig(format!("{field} is {value}, at most {max} is supported")));
+        }
+        // Each width and depth within its bound can still multiply to a network no machine holds.
+        let parameters = self.network_parameters();
+        if parameters > Self::MAX_NETWORK_PARAMETERS {
+            return Err(TrainError::InvalidConfig(format!(
+                "network: {parameters} parameters (latent_dim {}, {} message-passing steps), at most {} are supported",
+                self.network.latent_dim,
+                self.network.message_passing_steps,
+                Self::MAX_NETWORK_PARAMETERS
+            )));
         }
         Ok(())
     }
@@ -245,5 +275,24 @@ mod tests {
         };
         let message = huge.validate().unwrap_err().to_string();
         assert!(message.contains("network.latent_dim") && message.contains("1024"), "{message}");
+    }
+
+    #[test]
+    fn networks_must_fit_and_rollouts_take_a_step() {
+        // As the fuzz input fuzz/corpus/training_config/crash-network-too-large (1.9 billion
+        // parameters, 28 GB of training state): each field within its own bound.
+        let wide_and_deep = |latent_dim, message_passing_steps| TrainingConfig {
+            network: NetworkConfig { latent_dim, message_passing_steps, ..TrainingConfig::quick().network },
+            ..TrainingConfig::quick()
+        };
+        let message = wide_and_deep(1_024, 256).validate().unwrap_err().to_string();
+        assert!(message.contains("network: 2151953409 parameters") && message.contains("100000000"), "{message}");
+        wide_and_deep(1_024, 10).validate().unwrap();
+        // As fuzz/corpus/training_config/crash-zero-inference-steps: a model trained so had a card
+        // that `amber mesh` cannot use.
+        let none = TrainingConfig { inference_steps: 0, ..TrainingConfig::quick() };
+        assert!(none.validate().unwrap_err().to_string().contains("inference_steps must be positive"));
+        wide_and_deep(64, 256).validate().unwrap();
+        assert!(wide_and_deep(1_024, 12).validate().is_err());
     }
 }

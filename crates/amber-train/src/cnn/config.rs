@@ -56,6 +56,9 @@ impl Default for CnnConfig {
 }
 
 impl CnnConfig {
+    /// The finest grid a run (and a model file) may ask for, pixels per axis.
+    pub const MAX_RESOLUTION: usize = 2_048;
+
     /// The paper's runs (spec §8, reference notes §8): resolution 256, 64 initial channels, MSE
     /// on log sizes, mean labels, all 20 images in every one of 25,600 steps, Adam 3e-4, clip
     /// 0.5. GPU scale.
@@ -154,8 +157,14 @@ impl CnnConfig {
             return bad("normalise_labels needs loss log_mse or mse");
         }
         // Upper bounds that a machine can hold, so that a typo is an error, not an abort.
-        if self.resolution > 2_048 || self.initial_channels > 1_024 || self.data.train_problems > 1_000_000 {
-            return bad("resolution at most 2048, initial_channels at most 1024, data.train_problems at most 1000000");
+        if self.resolution > Self::MAX_RESOLUTION
+            || self.initial_channels > 1_024
+            || self.data.train_problems > 1_000_000
+        {
+            return Err(TrainError::InvalidConfig(format!(
+                "resolution at most {}, initial_channels at most 1024, data.train_problems at most 1000000",
+                Self::MAX_RESOLUTION
+            )));
         }
         Ok(())
     }

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::model_file::{check_limits, check_moments, read_checked};
-use crate::{PredictedField, SizingModel};
+use crate::{CnnConfig, PredictedField, SizingModel};
 
 /// File of the U-Net weights (and BatchNorm statistics) inside a CNN model directory.
 pub const CNN_WEIGHTS_FILE: &str = "cnn.safetensors";
@@ -108,14 +108,26 @@ impl CnnPredictor {
         read_checked(path, Self::validate)
     }
 
-    /// Checks what a file could get wrong: the network's configuration, a positive resolution,
-    /// an objective that needs no current mesh, the input and label moments (finite,
-    /// non-negative variances, positive counts, one column per input channel or one label) and
-    /// the limits (positive).
+    /// Checks what a file could get wrong: the network's configuration, a resolution the
+    /// network can pool (a positive multiple of 2^depth) and a run could have trained at (at most
+    /// [`CnnConfig::MAX_RESOLUTION`]), an objective that needs no current mesh, the input and
+    /// label moments (finite, non-negative variances, positive counts, one column per input
+    /// channel or one label) and the limits (positive).
     fn validate(&self) -> Result<(), String> {
         self.network.validate().map_err(|e| format!("network: {e}"))?;
-        if self.resolution == 0 {
-            return Err("resolution is 0".into());
+        let multiple = self.network.size_multiple();
+        if self.resolution == 0 || !self.resolution.is_multiple_of(multiple) {
+            return Err(format!(
+                "resolution is {}, not a positive multiple of {multiple} (a depth of {})",
+                self.resolution, self.network.depth
+            ));
+        }
+        if self.resolution > CnnConfig::MAX_RESOLUTION {
+            return Err(format!(
+                "resolution is {}, at most {} is supported",
+                self.resolution,
+                CnnConfig::MAX_RESOLUTION
+            ));
         }
         if self.objective.needs_current_size() {
             return Err("loss softplus_residual needs a current mesh".into());
