@@ -30,7 +30,7 @@ use crate::timing::{CpuClock, Load, LoadMeter, median_time};
 pub struct Args {
     /// Where to write the results.
     #[arg(long, default_value = "results/bench/fem.json")]
-    out: PathBuf,
+    pub out: PathBuf,
     /// Rayon threads for the parallel assembly.
     #[arg(long, default_value_t = 2)]
     threads: usize,

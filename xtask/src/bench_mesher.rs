@@ -23,7 +23,7 @@ use crate::timing::{CpuClock, Load, LoadMeter, median_time};
 pub struct Args {
     /// Where to write the results.
     #[arg(long, default_value = "results/bench/mesher.json")]
-    out: PathBuf,
+    pub out: PathBuf,
     /// Timed repetitions per case (the median is reported).
     #[arg(long, default_value_t = 3)]
     repeats: usize,

@@ -29,7 +29,7 @@ pub struct Args {
     data: PathBuf,
     /// Where to write the results.
     #[arg(long, default_value = "results/bench/mesher3d.json")]
-    out: PathBuf,
+    pub out: PathBuf,
     /// Threads (the acceptance times are single-threaded).
     #[arg(long, default_value_t = 1)]
     threads: usize,

@@ -29,7 +29,7 @@ use crate::timing::{CpuClock, Load, LoadMeter, cpu_seconds};
 pub struct Args {
     /// Where to write the results.
     #[arg(long, default_value = "results/bench/metrics.json")]
-    out: PathBuf,
+    pub out: PathBuf,
     /// Rayon threads for the timed runs.
     #[arg(long, default_value_t = 2)]
     threads: usize,

@@ -1,7 +1,8 @@
 //! `cargo xtask`: benchmarks, datasets and reproductions of the paper's experiments.
 //!
-//! Every command writes its results atomically under `results/` (or `--out`), with the settings
-//! and the machine beside the numbers.
+//! Every command writes its results atomically under `results/` (or `--out`), with the settings,
+//! the machine and the commit beside the numbers; only a build of a clean commit writes under
+//! `results/`.
 
 mod bench_cnn;
 mod bench_fem;
@@ -64,6 +65,30 @@ enum Bench {
     Cnn(bench_cnn::Args),
 }
 
+impl Bench {
+    /// Runs the bench, refusing at once (not after minutes of timing) a results file under
+    /// `results/` that a dirty build would write.
+    fn run(self) -> anyhow::Result<()> {
+        let out = match &self {
+            Bench::Mesher(args) => &args.out,
+            Bench::Mesher3d(args) => &args.out,
+            Bench::Metrics(args) => &args.out,
+            Bench::Fem(args) => &args.out,
+            Bench::Mpn(args) => &args.out,
+            Bench::Cnn(args) => &args.out,
+        };
+        report::check_provenance(out, None)?;
+        match self {
+            Bench::Mesher(args) => bench_mesher::run(args),
+            Bench::Mesher3d(args) => bench_mesher3d::run(args),
+            Bench::Metrics(args) => bench_metrics::run(args),
+            Bench::Fem(args) => bench_fem::run(args),
+            Bench::Mpn(args) => bench_mpn::run(args),
+            Bench::Cnn(args) => bench_cnn::run(args),
+        }
+    }
+}
+
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
@@ -76,12 +101,7 @@ fn main() -> anyhow::Result<()> {
     // Commands run from any directory; relative paths are taken from the workspace root.
     std::env::set_current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))?;
     match Cli::parse().command {
-        Command::Bench(Bench::Mesher(args)) => bench_mesher::run(args),
-        Command::Bench(Bench::Mesher3d(args)) => bench_mesher3d::run(args),
-        Command::Bench(Bench::Metrics(args)) => bench_metrics::run(args),
-        Command::Bench(Bench::Fem(args)) => bench_fem::run(args),
-        Command::Bench(Bench::Mpn(args)) => bench_mpn::run(args),
-        Command::Bench(Bench::Cnn(args)) => bench_cnn::run(args),
+        Command::Bench(bench) => bench.run(),
         Command::Dataset(args) => dataset::run(args),
         Command::ShipModel(args) => ship_model::run(args),
         Command::ReferenceDistances(args) => reference_distances::run(args),

@@ -13,6 +13,7 @@ use amber_tasks::poisson::Difficulty;
 use amber_train::Profile;
 
 use crate::plan::{self, Action, GridArgs};
+use crate::report;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -134,7 +135,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn console(args: ConsoleArgs) -> anyhow::Result<()> {
-    check_provenance(&args.out, args.allow_dirty)?;
+    report::check_provenance(&args.out, Some(args.allow_dirty))?;
     let mut experiment = ConsoleExperiment::new(args.profile, &args.data);
     if args.all_train {
         experiment.train_set = TrainSet::All;
@@ -153,7 +154,7 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
 }
 
 fn poisson(args: PoissonArgs) -> anyhow::Result<()> {
-    check_provenance(&args.out, args.allow_dirty)?;
+    report::check_provenance(&args.out, Some(args.allow_dirty))?;
     let mut experiment = PoissonExperiment::new(args.profile);
     if !args.difficulty.is_empty() {
         experiment.difficulties = args.difficulty;
@@ -195,7 +196,7 @@ pub struct AblateArgs {
 
 /// `cargo xtask ablate`: every ablation of spec §10 as variants of the same training code.
 pub fn ablate(args: AblateArgs) -> anyhow::Result<()> {
-    check_provenance(&args.out, args.allow_dirty)?;
+    report::check_provenance(&args.out, Some(args.allow_dirty))?;
     poisson_schedule(PoissonExperiment::ablation(args.profile), args.data, &args.grid, args.out)
 }
 
@@ -231,20 +232,6 @@ fn schedule(
             Ok(())
         }
     }
-}
-
-/// Refuses to write under `results/` (the committed evidence) from a binary built from a dirty
-/// tree, unless `allow_dirty`.
-fn check_provenance(out: &Path, allow_dirty: bool) -> anyhow::Result<()> {
-    if out.starts_with("results") && !allow_dirty && !amber_experiments::built_from_a_clean_commit() {
-        anyhow::bail!(
-            "{}: this binary was built from {}, not a clean commit; commit first, write elsewhere (--out) or pass \
-             --allow-dirty",
-            out.display(),
-            amber_experiments::commit()
-        );
-    }
-    Ok(())
 }
 
 /// Prints each run's headline numbers and where the outputs went.
