@@ -9,7 +9,7 @@ use amber_mpn::MpnConfig;
 use amber_mpn::bench::{BenchCase, BenchStep, candle_threads};
 use amber_stdx::median;
 use amber_train::TrainingConfig;
-use anyhow::{Context, bail};
+use anyhow::bail;
 use serde_json::{Value, json};
 
 use crate::peer::{Peer, PeerDir};
@@ -95,12 +95,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "ratios": ratios(&cases, peer.as_ref()),
         "peer": peer,
     });
-    if let Some(dir) = args.out.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    std::fs::write(&args.out, serde_json::to_string_pretty(&result)?)
-        .with_context(|| format!("writing {}", args.out.display()))?;
-    println!("wrote {}", args.out.display());
+    crate::report::write_json(&args.out, &result)?;
     Ok(())
 }
 
