@@ -40,6 +40,11 @@ struct ConsoleArgs {
     /// Train on all 19 training parts instead of the paper's 15.
     #[arg(long)]
     all_train: bool,
+    /// A K-fold cross-validation over the training parts (with --all-train, all 19) instead of
+    /// scoring on test/ or val/: part i is held out by fold i mod K, and each part is scored by
+    /// the model that did not train on it. For choosing settings without touching val/ or test/.
+    #[arg(long)]
+    folds: Option<usize>,
     /// Training seeds 0..N (default: the profile's).
     #[arg(long)]
     seeds: Option<usize>,
@@ -54,9 +59,9 @@ struct ConsoleArgs {
     /// no commit that made them).
     #[arg(long)]
     allow_dirty: bool,
-    /// Output directory.
-    #[arg(long, default_value = "results/console")]
-    out: PathBuf,
+    /// Output directory [default: results/console, or results/console-cv with --folds].
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(clap::Args, Debug)]
@@ -135,11 +140,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn console(args: ConsoleArgs) -> anyhow::Result<()> {
-    report::check_provenance(&args.out, Some(args.allow_dirty))?;
+    let default_out = if args.folds.is_some() { "results/console-cv" } else { "results/console" };
+    let out = args.out.unwrap_or_else(|| default_out.into());
+    report::check_provenance(&out, Some(args.allow_dirty))?;
     let mut experiment = ConsoleExperiment::new(args.profile, &args.data);
     if args.all_train {
         experiment.train_set = TrainSet::All;
     }
+    experiment.folds = args.folds;
     if let Some(seeds) = args.seeds {
         experiment.seeds = seeds;
     }
@@ -149,7 +157,7 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
     (experiment.overrides, experiment.cnn_overrides) = args.overrides.read()?;
     experiment.cache = args.grid.cache_policy();
     experiment.runs_root = args.grid.runs_root().into();
-    experiment.out = args.out;
+    experiment.out = out;
     schedule(&args.grid, &experiment.out, || experiment.plan(), |key| experiment.run_one(key), || experiment.run())
 }
 

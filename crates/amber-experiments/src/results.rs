@@ -203,9 +203,15 @@ impl ExperimentResults {
         }
     }
 
-    /// The problems the runs were evaluated on, for captions: the test problems, or the split a
-    /// task without a test split fell back to (`config.test_split`).
+    /// The problems the runs were evaluated on, for captions: the test problems, the split a
+    /// task without a test split fell back to (`config.test_split`), or the training parts of a
+    /// cross-validation (`config.experiment.folds`).
     pub fn evaluated_on(&self) -> String {
+        if let Some(folds) = self.config["experiment"]["folds"].as_u64() {
+            return format!(
+                "the training parts in a {folds}-fold cross-validation (each scored by the model that did not train on it)"
+            );
+        }
         match self.config["test_split"].as_str() {
             Some(split) if split != "test" => format!("the {split} problems (no test split)"),
             _ => "the test problems".into(),
@@ -276,5 +282,7 @@ mod tests {
         );
         assert_eq!(results(serde_json::json!({ "test_split": "test" })).evaluated_on(), "the test problems");
         assert_eq!(results(serde_json::json!({})).evaluated_on(), "the test problems");
+        let cv = results(serde_json::json!({ "test_split": "cross-validation", "experiment": { "folds": 4 } }));
+        assert!(cv.evaluated_on().starts_with("the training parts in a 4-fold cross-validation"));
     }
 }

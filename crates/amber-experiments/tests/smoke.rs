@@ -196,3 +196,32 @@ fn console_smoke_trains_evaluates_on_val_and_draws_surfaces() {
     // Two methods × two parts; steps 1, 2, T and the expert.
     assert_eq!(png_size(&experiment.out.join("gallery_console_view1.png")), (4 * 460, 4 * 380));
 }
+
+#[test]
+fn console_cross_validation_scores_every_training_part_once() {
+    let Some(data) = amber_testdata::shared("data/console") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let mut experiment = amber_experiments::ConsoleExperiment::new(Profile::Smoke, &data);
+    experiment.runs_root = dir.path().join("data/runs");
+    experiment.out = dir.path().join("results/console-cv");
+    experiment.methods = vec![amber_experiments::MethodSpec::plain(amber_experiments::Method::AmberMax)];
+    experiment.overrides = serde_json::json!({ "steps": 4, "checkpoint_interval": 4, "validation_interval": 0 });
+    experiment.folds = Some(1);
+    assert!(experiment.plan().unwrap_err().to_string().contains("takes 2 to 15 folds"));
+    // The paper's 15 training parts in 5 folds of 3: part i is held out by fold i mod 5.
+    experiment.folds = Some(5);
+    let plan = experiment.plan().unwrap();
+    assert_eq!(plan.len(), 5, "one run per fold");
+    assert!(plan.iter().enumerate().all(|(f, run)| run.key.contains(&format!("console-cv5-fold{f}/"))), "{plan:?}");
+    let results = experiment.run().unwrap();
+    assert_eq!(results.config["test_split"], "cross-validation");
+    assert_eq!(results.runs.len(), 1, "the folds pool into one row");
+    let run = &results.runs[0];
+    assert_eq!((run.difficulty.as_str(), run.test_problems), ("console-cv", 15));
+    let names: Vec<&str> = run.problems.iter().map(|p| p.name.as_deref().unwrap()).collect();
+    let expected: Vec<String> = (0..5).flat_map(|f| (0..3).map(move |k| format!("{:03}", 1 + f + 5 * k))).collect();
+    assert_eq!(names, expected, "fold order, each part once");
+    let table = std::fs::read_to_string(experiment.out.join("table.md")).unwrap();
+    assert!(table.contains("5-fold cross-validation"), "{table}");
+    assert!(table.contains("| amber-max | ") && !table.contains("0.238"), "no paper number beside a CV score: {table}");
+}
