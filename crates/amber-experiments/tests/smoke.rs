@@ -162,15 +162,23 @@ fn ablations_are_variants_of_one_training_path_with_the_papers_numbers_beside() 
     assert!(experiment.out.join("ndcd_bars.png").exists());
 }
 
+/// The smoke Console experiment on ../shared/data/console (`None` where it is absent), its runs
+/// and outputs under `dir`, training `steps` steps: these tests check the 3D plumbing end to
+/// end, not the quality.
+fn console_experiment(dir: &Path, steps: u64) -> Option<amber_experiments::ConsoleExperiment> {
+    let data = amber_testdata::shared("data/console")?;
+    let mut experiment = amber_experiments::ConsoleExperiment::new(Profile::Smoke, &data);
+    experiment.runs_root = dir.join("data/runs");
+    experiment.out = dir.join("results/console");
+    experiment.overrides =
+        serde_json::json!({ "steps": steps, "checkpoint_interval": steps.div_ceil(2), "validation_interval": 0 });
+    Some(experiment)
+}
+
 #[test]
 fn console_smoke_trains_evaluates_on_val_and_draws_surfaces() {
-    let Some(data) = amber_testdata::shared("data/console") else { return };
     let dir = tempfile::tempdir().unwrap();
-    let mut experiment = amber_experiments::ConsoleExperiment::new(Profile::Smoke, &data);
-    experiment.runs_root = dir.path().join("data/runs");
-    experiment.out = dir.path().join("results/console");
-    // Few steps: this checks the 3D plumbing end to end, not the quality.
-    experiment.overrides = serde_json::json!({ "steps": 16, "checkpoint_interval": 8, "validation_interval": 0 });
+    let Some(experiment) = console_experiment(dir.path(), 16) else { return };
     let results = experiment.run().unwrap();
     assert_eq!(results.experiment, "console");
     assert_eq!(results.config["test_split"], "val");
@@ -199,13 +207,9 @@ fn console_smoke_trains_evaluates_on_val_and_draws_surfaces() {
 
 #[test]
 fn console_cross_validation_scores_every_training_part_once() {
-    let Some(data) = amber_testdata::shared("data/console") else { return };
     let dir = tempfile::tempdir().unwrap();
-    let mut experiment = amber_experiments::ConsoleExperiment::new(Profile::Smoke, &data);
-    experiment.runs_root = dir.path().join("data/runs");
-    experiment.out = dir.path().join("results/console-cv");
+    let Some(mut experiment) = console_experiment(dir.path(), 4) else { return };
     experiment.methods = vec![amber_experiments::MethodSpec::plain(amber_experiments::Method::AmberMax)];
-    experiment.overrides = serde_json::json!({ "steps": 4, "checkpoint_interval": 4, "validation_interval": 0 });
     experiment.folds = Some(1);
     assert!(experiment.plan().unwrap_err().to_string().contains("takes 2 to 15 folds"));
     // The paper's 15 training parts in 5 folds of 3: part i is held out by fold i mod 5.
