@@ -209,7 +209,7 @@ impl ExperimentResults {
     pub fn evaluated_on(&self) -> String {
         if let Some(folds) = self.config["experiment"]["folds"].as_u64() {
             return format!(
-                "the training parts in a {folds}-fold cross-validation (each scored by the model that did not train on it)"
+                "the training parts of a {folds}-fold cross-validation, each scored by the model that did not train on it"
             );
         }
         match self.config["test_split"].as_str() {
@@ -283,6 +283,6 @@ mod tests {
         assert_eq!(results(serde_json::json!({ "test_split": "test" })).evaluated_on(), "the test problems");
         assert_eq!(results(serde_json::json!({})).evaluated_on(), "the test problems");
         let cv = results(serde_json::json!({ "test_split": "cross-validation", "experiment": { "folds": 4 } }));
-        assert!(cv.evaluated_on().starts_with("the training parts in a 4-fold cross-validation"));
+        assert!(cv.evaluated_on().starts_with("the training parts of a 4-fold cross-validation, each"));
     }
 }
