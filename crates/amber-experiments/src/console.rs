@@ -112,11 +112,9 @@ impl ConsoleExperiment {
             if r.seed == 0 && r.spec.variant.name == "default" && *fold == 0 {
                 rows.push((r.spec.label(), r.run.gallery_meshes(r.config.inference_steps())?));
             }
-            // The folds of a method and seed follow each other (see `grid`).
+            // The folds of a method and seed follow each other, fold 0 first (see `grid`).
             match evaluations.last_mut() {
-                Some((first, folds)) if *fold > 0 && first.spec == r.spec && first.seed == r.seed => {
-                    folds.push(evaluated)
-                }
+                Some((_, folds)) if *fold > 0 => folds.push(evaluated),
                 _ => evaluations.push((r, vec![evaluated])),
             }
         }
@@ -171,16 +169,15 @@ impl ConsoleExperiment {
                 (Setting { name: "console".into(), caption }, vec![test], vec![name], split.name().to_owned())
             }
             Some(folds) => {
-                let parts = self.load(Split::Train, usize::MAX, |_| true)?;
-                if folds < 2 || folds > parts.len() {
-                    let n = parts.len();
-                    bail!("{folds} folds: a cross-validation over {n} training parts takes 2 to {n} folds");
+                let all = self.load(Split::Train, usize::MAX, |_| true)?;
+                let parts = all.len();
+                if folds < 2 || folds > parts {
+                    bail!("{folds} folds: a cross-validation over {parts} training parts takes 2 to {parts} folds");
                 }
                 let mut tests: Vec<Vec<Part>> = (0..folds).map(|_| Vec::new()).collect();
-                for (i, part) in parts.into_iter().enumerate() {
+                for (i, part) in all.into_iter().enumerate() {
                     tests[i % folds].push(part);
                 }
-                let parts: usize = tests.iter().map(Vec::len).sum();
                 let names = (0..folds)
                     .map(|f| format!("console {folds}-fold cross-validation, fold {f} ({} parts)", tests[f].len()))
                     .collect();
@@ -243,10 +240,7 @@ impl ConsoleExperiment {
             Split::Train => self.train_set.part_limit(),
             Split::Val | Split::Test => None,
         };
-        // Without a selection, only the files wanted are read.
-        let read =
-            if self.folds.is_none() { limit.map_or(count, |l| l.min(count)) } else { limit.unwrap_or(usize::MAX) };
-        let experts = read_experts::<3>(&split.dir(&self.data), Some(read))?;
+        let experts = read_experts::<3>(&split.dir(&self.data), limit)?;
         let experts = experts.into_iter().enumerate().filter(|(i, _)| keep(*i)).map(|(_, e)| e).take(count).collect();
         Ok(problems(experts, INITIAL_SIZE, &DatasetSettings::read(&self.data)?)?)
     }

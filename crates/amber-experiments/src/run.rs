@@ -47,10 +47,7 @@ pub(crate) struct CachedEvaluation {
 impl CachedEvaluation {
     /// The evaluations of a cross-validation's folds (at least one) as one: every fold's
     /// problems in fold order, the folds' summed training and evaluation times.
-    pub fn pooled(mut folds: Vec<CachedEvaluation>) -> Self {
-        if folds.len() == 1 {
-            return folds.remove(0);
-        }
+    pub fn pooled(folds: Vec<CachedEvaluation>) -> Self {
         Self {
             test_set: folds.iter().map(|f| f.test_set.as_str()).collect::<Vec<_>>().join("; "),
             train_seconds: folds.iter().map(|f| f.train_seconds).sum(),
