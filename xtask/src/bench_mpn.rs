@@ -2,6 +2,7 @@
 //! large random mesh-like graph, for the stock-candle composition and the fused ops, optionally
 //! next to the PyTorch peer (`shared/peers/bench_mpn.py`) run on a graph of the same size.
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -12,7 +13,7 @@ use amber_train::TrainingConfig;
 use anyhow::bail;
 use serde_json::{Value, json};
 
-use crate::peer::{Peer, PeerDir};
+use crate::peer::{self, Peer, PeerDir};
 use crate::timing::{CpuClock, CpuTimer, LoadMeter};
 
 #[derive(clap::Args, Debug)]
@@ -20,6 +21,10 @@ pub struct Args {
     /// Where to write the results (JSON).
     #[arg(long, default_value = "results/bench/mpn.json")]
     pub out: PathBuf,
+    /// Latent width D of the network (64: Poisson's; 128: Console's). The peer runs at the same
+    /// width (other than 64 through `xtask/peers/mpn_latent.py`).
+    #[arg(long, default_value_t = 64)]
+    pub latent: usize,
     /// Nodes of the benchmark graph.
     #[arg(long, default_value_t = 50_000)]
     pub nodes: usize,
@@ -55,7 +60,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let config = MpnConfig::poisson();
+    let config = MpnConfig::small(args.latent, MpnConfig::poisson().network.message_passing_steps);
     let paper = TrainingConfig::paper();
     let mut cases = Vec::new();
     for variant in &args.variants {
@@ -164,14 +169,24 @@ fn peak_rss_gib() -> Option<f64> {
 }
 
 /// Runs the PyTorch peer (plain and PyG aggregation) on a graph of the same size, with self-loops,
-/// and returns its JSON.
+/// at the same latent width, and returns its JSON.
 fn run_peer(python: &Path, args: &Args) -> anyhow::Result<Value> {
     let sizes = args.nodes.to_string();
     let steps = args.iters.to_string();
-    let peer_args =
-        ["--sizes", &sizes, "--variants", "plain,pyg", "--ckpt-sizes", "", "--self-loops", "--steps", &steps];
+    let mut peer_args: Vec<&OsStr> = Vec::new();
+    let (script, latent) = (args.peer_script.as_os_str(), args.latent.to_string());
+    // The peer's width is a module constant (64); `mpn_latent.py` runs it at another.
+    let wrapper = Path::new(peer::SCRIPTS).join("mpn_latent.py");
+    let entry = if args.latent == MpnConfig::poisson().network.latent_dim {
+        script
+    } else {
+        peer_args.extend([script, OsStr::new(&latent)]);
+        wrapper.as_os_str()
+    };
+    let rest = ["--sizes", &sizes, "--variants", "plain,pyg", "--ckpt-sizes", "", "--self-loops", "--steps", &steps];
+    peer_args.extend(rest.iter().map(OsStr::new));
     let peer = Peer { python, threads: args.peer_threads };
-    peer.run(&args.peer_script, &peer_args, &[], &PeerDir::new("mpn")?, "mpn.json")
+    peer.run(Path::new(entry), &peer_args, &[], &PeerDir::new("mpn")?, "mpn.json")
 }
 
 /// Speed-ups of the fused variant over the naive one and over each peer case.

@@ -17,7 +17,7 @@ use anyhow::{Context, bail};
 use serde_json::Value;
 
 /// Where our peer scripts live, from the workspace root.
-const SCRIPTS: &str = "xtask/peers";
+pub const SCRIPTS: &str = "xtask/peers";
 
 /// A Python interpreter with the peer libraries, and the threads it may use.
 pub struct Peer<'a> {
