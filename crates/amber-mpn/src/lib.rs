@@ -1,7 +1,8 @@
 //! The message passing network (MPN) of AMBER in candle: it maps a mesh graph (nodes =
 //! elements) to one scalar per node, an element size through the objective
 //! (`amber_nn::Objective`, spec §5), and the fused CPU custom ops that make it fast enough to
-//! train on CPUs.
+//! train on CPUs. On another device (`amber_nn::Backend::Cuda`, the `cuda` feature) the same
+//! network runs as stock candle ops, the composition the fused ops are tested against.
 //!
 //! Input is an [`amber_graph::GraphBatch`]; this crate knows nothing of meshes, meshing, labels
 //! or the training loop around a step. [`MpnTrainer`] (one training step: forward, loss, Adam

@@ -189,10 +189,10 @@ impl Mpn {
         Ok(model)
     }
 
-    /// Loads a checkpoint written by [`Mpn::save`] into new f32 variables on the CPU, to resume
+    /// Loads a checkpoint written by [`Mpn::save`] into new f32 variables on `device`, to resume
     /// training; checked as in [`Mpn::load`].
-    pub fn load_trainable(path: &Path) -> Result<(Self, VarMap)> {
-        let (model, mut varmap) = Self::init(read_config(path)?, 0, DType::F32, &Device::Cpu)?;
+    pub fn load_trainable(path: &Path, device: &Device) -> Result<(Self, VarMap)> {
+        let (model, mut varmap) = Self::init(read_config(path)?, 0, DType::F32, device)?;
         let stored = read_tensors(path)?.len();
         // `VarMap::load` overwrites the variables the model created (shape-checked); it would
         // load nothing into an empty map.
@@ -265,6 +265,10 @@ impl Mpn {
     /// result can be differentiated once (the fused ops hand their saved activations to the first
     /// backward pass).
     pub fn forward(&self, graph: &GraphInput) -> Result<Tensor> {
+        // The fused ops are CPU kernels; elsewhere candle's own ops compute the same function.
+        if !graph.node_features.device().is_cpu() {
+            return self.forward_naive(graph);
+        }
         let (mut x, mut e) = self.encode(graph)?;
         for step in &self.steps {
             e = ops::edge_update(&x, &e, &step.edge.packed()?, &graph.topology)?;

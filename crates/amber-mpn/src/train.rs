@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use amber_graph::GraphBatch;
-use amber_nn::{Adam, Objective};
+use amber_nn::{Adam, Backend, Objective};
 use candle_core::{DType, Device, Tensor};
 use candle_nn::VarMap;
 use rand::Rng;
@@ -24,9 +24,11 @@ pub struct StepLoss {
     pub grad_norm: f64,
 }
 
-/// A trainable network (f32, on the CPU) with its variables, objective and optimiser.
+/// A trainable network (f32, on its backend's device) with its variables, objective and
+/// optimiser.
 pub struct MpnTrainer {
     network: Mpn,
+    device: Device,
     varmap: VarMap,
     objective: Objective,
     optimiser: Adam,
@@ -34,18 +36,27 @@ pub struct MpnTrainer {
 
 impl MpnTrainer {
     /// A freshly initialised network (drawn from `seed`, see [`Mpn::init`]) and fresh moments;
-    /// trained for `objective`; gradients are clipped to a global norm of `max_grad_norm` if set.
-    pub fn new(config: MpnConfig, objective: Objective, seed: u64, max_grad_norm: Option<f64>) -> Result<Self> {
-        let (network, varmap) = Mpn::init(config, seed, DType::F32, &Device::Cpu)?;
+    /// trained for `objective` on `backend`; gradients are clipped to a global norm of
+    /// `max_grad_norm` if set.
+    pub fn new(
+        config: MpnConfig,
+        objective: Objective,
+        seed: u64,
+        max_grad_norm: Option<f64>,
+        backend: Backend,
+    ) -> Result<Self> {
+        let device = backend.device()?;
+        let (network, varmap) = Mpn::init(config, seed, DType::F32, &device)?;
         let optimiser = Adam::new(&varmap, max_grad_norm)?;
-        Ok(Self { network, varmap, objective, optimiser })
+        Ok(Self { network, device, varmap, objective, optimiser })
     }
 
-    /// The network of a checkpoint written by [`Self::save`], with fresh moments.
-    pub fn load(weights: &Path, objective: Objective, max_grad_norm: Option<f64>) -> Result<Self> {
-        let (network, varmap) = Mpn::load_trainable(weights)?;
+    /// The network of a checkpoint written by [`Self::save`], on `backend`, with fresh moments.
+    pub fn load(weights: &Path, objective: Objective, max_grad_norm: Option<f64>, backend: Backend) -> Result<Self> {
+        let device = backend.device()?;
+        let (network, varmap) = Mpn::load_trainable(weights, &device)?;
         let optimiser = Adam::new(&varmap, max_grad_norm)?;
-        Ok(Self { network, varmap, objective, optimiser })
+        Ok(Self { network, device, varmap, objective, optimiser })
     }
 
     /// Restores the moments written by [`Self::save_optimiser`] and the count of updates taken.
@@ -73,10 +84,10 @@ impl MpnTrainer {
         lr: f64,
         rng: &mut R,
     ) -> Result<StepLoss> {
-        let input = GraphInput::from_batch(batch, DType::F32, &Device::Cpu)?;
+        let input = GraphInput::from_batch(batch, DType::F32, &self.device)?;
         let output = self.objective.activation(&self.network.forward_train(&input, rng)?)?;
         // The mean squared error, kept per node for the caller.
-        let squared_errors = (output - Tensor::from_slice(targets, batch.num_nodes, &Device::Cpu)?)?.sqr()?;
+        let squared_errors = (output - Tensor::from_slice(targets, batch.num_nodes, &self.device)?)?.sqr()?;
         let loss = squared_errors.mean_all()?;
         let squared_errors = squared_errors.to_vec1::<f32>()?;
         let loss_value = f64::from(loss.to_scalar::<f32>()?);

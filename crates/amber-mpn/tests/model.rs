@@ -200,7 +200,7 @@ fn checkpoints_round_trip_and_reject_wrong_shapes() {
     assert!(!out.track_op(), "inference from plain tensors must record no graph");
     assert_eq!(values(&out), expected);
     assert!(!model.for_inference().forward(&g).unwrap().track_op());
-    let (trainable, vars) = Mpn::load_trainable(&path).unwrap();
+    let (trainable, vars) = Mpn::load_trainable(&path, &Device::Cpu).unwrap();
     assert_eq!(values(&trainable.forward(&g).unwrap()), expected);
     assert_eq!(vars.all_vars().len(), model.parameters().len());
 
@@ -208,7 +208,7 @@ fn checkpoints_round_trip_and_reject_wrong_shapes() {
     for config in [MpnConfig::small(16, 3), MpnConfig::small(8, 2)] {
         std::fs::write(path.with_extension("json"), serde_json::to_string(&config).unwrap()).unwrap();
         assert!(matches!(Mpn::load(&path), Err(MpnError::Checkpoint { .. })));
-        assert!(matches!(Mpn::load_trainable(&path), Err(MpnError::Checkpoint { .. })));
+        assert!(matches!(Mpn::load_trainable(&path, &Device::Cpu), Err(MpnError::Checkpoint { .. })));
     }
     std::fs::write(path.with_extension("json"), "{\"latent_dim\": ").unwrap();
     assert!(matches!(Mpn::load(&path), Err(MpnError::Json { .. })));

@@ -3,7 +3,7 @@
 use amber_graph::GraphBatch;
 use amber_mpn::synthetic::random_graph;
 use amber_mpn::{MpnConfig, MpnTrainer};
-use amber_nn::Objective;
+use amber_nn::{Backend, Objective};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -11,7 +11,7 @@ use rand::{Rng, SeedableRng};
 fn training_lowers_the_loss_tenfold() {
     let config = MpnConfig::small(32, 3);
     let objective = Objective::SoftplusMse;
-    let mut trainer = MpnTrainer::new(config, objective, 0, Some(0.5)).unwrap();
+    let mut trainer = MpnTrainer::new(config, objective, 0, Some(0.5), Backend::Cpu).unwrap();
     let mut rng = StdRng::seed_from_u64(0);
     // Targets spread well beyond their mean, so a constant prediction cannot reach 1/10 of the
     // initial loss.

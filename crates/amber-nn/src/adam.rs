@@ -89,7 +89,7 @@ impl Adam {
                 if t.shape() != slot.shape() || t.dtype() != slot.dtype() {
                     bail!("optimiser moment `{key}` has shape {:?}", t.shape());
                 }
-                *slot = t;
+                *slot = t.to_device(slot.device())?;
             }
         }
         if let Some(extra) = tensors.keys().next() {

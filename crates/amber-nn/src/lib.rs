@@ -6,12 +6,13 @@
 //! bit-reproducible at any number of threads ([`reduce`]), the finiteness check of a loaded
 //! weights file ([`first_non_finite`]), the finite-difference gradient checker of both crates'
 //! op tests ([`gradcheck`]), and the one map between a network's scalar output and an element
-//! size ([`Objective`]).
+//! size ([`Objective`]), and the device a network trains on ([`Backend`]).
 //!
 //! This crate depends on candle, rayon and serde only; it knows nothing of meshes, graphs,
 //! images or training loops.
 
 mod adam;
+mod backend;
 mod finite;
 pub mod gradcheck;
 mod objective;
@@ -19,5 +20,6 @@ pub mod op;
 pub mod reduce;
 
 pub use adam::{Adam, clip_grad_norm, grad_norm};
+pub use backend::Backend;
 pub use finite::first_non_finite;
 pub use objective::{Objective, softplus, softplus_inverse};

@@ -36,7 +36,7 @@ pub use amber::{
     ReplayBuffer, Sample, SourceSelection, TargetTransform, Training, TrainingConfig, WEIGHTS_FILE,
 };
 pub use amber_mpn::NetworkConfig;
-pub use amber_nn::Objective;
+pub use amber_nn::{Backend, Objective};
 pub use checkpoint::{AdditionCounts, CHECKPOINTS_DIR, latest_checkpoint};
 pub use cnn::{
     CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnConfig, CnnModel, CnnPredictor, CnnSizing, CnnStepReport, CnnTraining,

@@ -57,6 +57,8 @@ mod tests {
 
     use super::*;
     use crate::amber::PREDICTOR_FILE;
+    use amber_nn::Backend;
+
     use crate::{
         AmberModel, CNN_PREDICTOR_FILE, CNN_WEIGHTS_FILE, CnnModel, CnnPredictor, Objective, Predictor,
         TargetTransform, WEIGHTS_FILE,
@@ -74,8 +76,12 @@ mod tests {
             target: TargetTransform::new(Objective::SoftplusResidual, true),
             limits: LIMITS,
         };
-        AmberModel::save(&MpnTrainer::new(network, Objective::SoftplusResidual, 0, None).unwrap(), &predictor, dir)
-            .unwrap();
+        AmberModel::save(
+            &MpnTrainer::new(network, Objective::SoftplusResidual, 0, None, Backend::Cpu).unwrap(),
+            &predictor,
+            dir,
+        )
+        .unwrap();
     }
 
     /// An untrained CNN of two input channels.

@@ -260,3 +260,11 @@ fn the_optional_features_reach_a_saved_model_that_predicts_on_new_meshes() {
     assert_eq!(sizes[0].len(), problem.expert_mesh.num_elements());
     assert!(sizes[0].iter().all(|h| h.is_finite() && *h > 0.0));
 }
+
+#[cfg(not(feature = "cuda"))]
+#[test]
+fn a_gpu_device_in_a_cpu_build_is_an_error_that_says_so() {
+    let config = TrainingConfig { device: amber_train::Backend::Cuda(0), ..tiny_config(1) };
+    let Err(error) = Training::new(config, problems(&[11, 12])) else { panic!("trained on a GPU it has no code for") };
+    assert!(error.to_string().to_lowercase().contains("cuda"), "{error}");
+}

@@ -2,7 +2,7 @@
 
 use amber_graph::Aggregation;
 use amber_mpn::{MpnConfig, NetworkConfig};
-use amber_nn::Objective;
+use amber_nn::{Backend, Objective};
 use serde::{Deserialize, Serialize};
 
 use crate::config::{PAPER_LEARNING_RATE, PAPER_MAX_GRAD_NORM};
@@ -75,6 +75,11 @@ pub struct TrainingConfig {
     pub checkpoint_interval: u64,
     /// Roll out the validation problems every this many steps (and at the end); 0: never.
     pub validation_interval: u64,
+    /// Where the network trains: `"cpu"` (the fused kernels), or `{"cuda": 0}` in a build with
+    /// the `cuda` feature (stock candle ops; not bit-reproducible, CUDA's scatter-adds race).
+    /// Rollouts, meshing and inference stay on the CPU.
+    #[serde(skip_serializing_if = "Backend::is_cpu")]
+    pub device: Backend,
 }
 
 impl Default for TrainingConfig {
@@ -95,7 +100,7 @@ impl TrainingConfig {
     /// The paper's settings (spec §5, §6): Poisson hard, AMBER-Mean, softplus output with MSE on
     /// raw sizes, constant Adam 3e-4, clip 0.5, 400,000-node batches, 1,000-entry buffer with an
     /// addition every 8 steps, 128,000 steps, validation every 256-step iteration. Meant for a GPU
-    /// (this crate runs on the CPU today).
+    /// (set [`TrainingConfig::device`]).
     pub fn paper() -> Self {
         Self {
             seed: 0,
@@ -121,6 +126,7 @@ impl TrainingConfig {
             calibrate_element_count: false,
             checkpoint_interval: 2_560,
             validation_interval: 2_560,
+            device: Backend::Cpu,
         }
     }
 
@@ -266,6 +272,11 @@ mod tests {
         let expected = TrainingConfig { steps: 10, aggregation: Aggregation::Max, ..TrainingConfig::quick() };
         assert_eq!(partial, expected, "absent fields are the quick profile's");
         assert!(serde_json::from_str::<TrainingConfig>(r#"{"stepz": 10}"#).is_err());
+        // The device joined the config after runs were cached under its JSON: the CPU is not
+        // written, so their keys stay.
+        assert!(!serde_json::to_string(&TrainingConfig::quick()).unwrap().contains("device"));
+        let gpu: TrainingConfig = serde_json::from_str(r#"{"device": {"cuda": 0}}"#).unwrap();
+        assert_eq!(gpu.device, Backend::Cuda(0));
         let bad =
             TrainingConfig { objective: Objective::SoftplusMse, normalise_labels: true, ..TrainingConfig::quick() };
         assert!(bad.validate().is_err());

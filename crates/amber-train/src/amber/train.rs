@@ -114,7 +114,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             edge_features: features.edge_dim(D),
             network: config.network.clone(),
         };
-        let trainer = MpnTrainer::new(network_config, config.objective, config.seed, config.max_grad_norm)?;
+        let trainer =
+            MpnTrainer::new(network_config, config.objective, config.seed, config.max_grad_norm, config.device)?;
         let mut training = Self {
             buffer: ReplayBuffer::new(config.buffer_capacity),
             dropout_rng: seeded_stream(config.seed, 1),
@@ -159,7 +160,8 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             return Err(fail("the training problems differ from the checkpointed run's".into()));
         }
         state.check(problems.len()).map_err(fail)?;
-        let mut trainer = MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.objective, config.max_grad_norm)?;
+        let mut trainer =
+            MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.objective, config.max_grad_norm, config.device)?;
         let predictor = Predictor::read(&dir.join(super::model::PREDICTOR_FILE), trainer.network().config())?;
         trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
