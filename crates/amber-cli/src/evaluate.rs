@@ -84,12 +84,12 @@ pub struct EvaluateArgs {
 }
 
 pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
-    let split = if Split::Train.dir(&args.data).is_dir() {
-        let test = Split::Test.dir(&args.data);
-        if test.is_dir() { test } else { Split::Val.dir(&args.data) }
-    } else {
-        args.data.clone()
-    };
+    // A dataset folder need not hold a train/ split to be evaluated.
+    let split = [Split::Test, Split::Val]
+        .into_iter()
+        .map(|split| split.dir(&args.data))
+        .find(|dir| dir.is_dir())
+        .unwrap_or_else(|| args.data.clone());
     let loaded = args.model.load()?;
     loaded.check_dimension(&split)?;
     let LoadedModel { dir, card, mut model, steps } = loaded;

@@ -311,6 +311,11 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     let output = train_smoke_folder(&data, &config, dir.path().join("run2"), 30);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success() && stderr.contains("val") && !stderr.contains("panicked"), "{stderr}");
+
+    // A dataset folder of held-out parts alone (no train/) is evaluated on its test/.
+    std::fs::remove_dir_all(data.join("train")).unwrap();
+    let evaluation = evaluate(&run, &data, &dir.path().join("evaluation-test-only"));
+    assert_eq!(evaluation["parts"].as_array().unwrap().len(), 2);
 }
 
 /// Parts' own inputs (`<stem>.inputs.json`) train into a model that names them; meshing a new part

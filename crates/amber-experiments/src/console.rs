@@ -10,10 +10,10 @@ use std::path::{Path, PathBuf};
 
 use amber_mesh::Mesh3;
 use amber_plot::{Tile, TileMesh, View, mesh_gallery};
-use amber_tasks::WithExpert;
 use amber_tasks::console::{INITIAL_MESH_RECIPE, INITIAL_SIZE, TrainSet, check_data, has_test_split};
 use amber_tasks::folder::{DatasetSettings, Split, problems, read_experts};
 use amber_tasks::part::SolidPart;
+use amber_tasks::{Problem, WithExpert};
 use amber_train::{MethodConfig, Profile};
 use anyhow::bail;
 use serde::Serialize;
@@ -187,10 +187,19 @@ impl ConsoleExperiment {
             }
         };
         let parts = self.train_set.part_limit().map_or("all".to_owned(), |n| format!("the first {n}"));
-        let origin = RunOrigin {
-            task: Task::Console,
-            initial_size: INITIAL_SIZE,
-            data: format!("{parts} Console training parts of {}", self.data.display()),
+        let origin = |fold: usize| {
+            let held_out = match self.folds {
+                Some(folds) => {
+                    let names: Vec<String> = tests[fold].iter().map(|p| p.name()).collect();
+                    format!(" but the {} fold {fold} of {folds} holds out ({})", names.len(), names.join(", "))
+                }
+                None => String::new(),
+            };
+            RunOrigin {
+                task: Task::Console,
+                initial_size: INITIAL_SIZE,
+                data: format!("{parts} Console training parts of {}{held_out}", self.data.display()),
+            }
         };
         let mut runs = Vec::new();
         for seed in 0..self.seeds {
@@ -206,7 +215,7 @@ impl ConsoleExperiment {
                         setting = format!("console-cv{folds}-fold{fold}");
                     }
                     let test_name = evaluation_name(test_name.clone(), self.scale_to_budget);
-                    let run = Run::new(&self.runs_root, &origin, &setting, spec, &config, data, &test_name);
+                    let run = Run::new(&self.runs_root, &origin(fold), &setting, spec, &config, data, &test_name);
                     runs.push((GridRun { spec: spec.clone(), seed, config: config.clone(), run }, fold));
                 }
             }

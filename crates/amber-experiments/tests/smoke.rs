@@ -225,6 +225,11 @@ fn console_cross_validation_scores_every_training_part_once() {
     let names: Vec<&str> = run.problems.iter().map(|p| p.name.as_deref().unwrap()).collect();
     let expected: Vec<String> = (0..5).flat_map(|f| (0..3).map(move |k| format!("{:03}", 1 + f + 5 * k))).collect();
     assert_eq!(names, expected, "fold order, each part once");
+    let card = std::fs::read_to_string(plan[0].dir.join("model/card.json")).unwrap();
+    assert!(
+        card.contains("but the 3 fold 0 of 5 holds out (001, 006, 011)"),
+        "the card names the parts not trained on: {card}"
+    );
     let table = std::fs::read_to_string(experiment.out.join("table.md")).unwrap();
     assert!(table.contains("5-fold cross-validation"), "{table}");
     assert!(table.contains("| amber-max | ") && !table.contains("0.238"), "no paper number beside a CV score: {table}");
