@@ -5,7 +5,6 @@
 //! it is: docs/PROFILES.md.
 
 use amber_tasks::LOG_SIZE_COLUMN;
-use amber_tasks::part::GEOMETRY_INPUTS;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
 use amber_train::{CnnConfig, MethodConfig, Profile, TrainingConfig};
 
@@ -45,6 +44,11 @@ impl Task {
     }
 }
 
+/// The geometry inputs (`amber_tasks::part::GEOMETRY_INPUTS`) the Console and folder profiles
+/// read: those measured to help (docs/PROFILES.md, "Geometry inputs"). `log_curvature_radius`
+/// is offered to `--config` but not yet measured.
+const PROFILE_GEOMETRY_INPUTS: [&str; 3] = ["log_boundary_distance", "log_feature_distance", "feature_turn"];
+
 /// AMBER's configuration of `task` under `profile` (before the method's labels and the seed).
 /// Console is one folder dataset of 3D parts meshed by human experts: it and every 3D folder get
 /// the same values, so `amber train --data` on the Console folder trains what `reproduce console`
@@ -69,7 +73,7 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
             }
             // Where the geometry is (boundary, feature curves): Console val 0.235 → 0.167.
             if profile != Profile::Paper {
-                config.inputs.extend(GEOMETRY_INPUTS.map(String::from));
+                config.inputs.extend(PROFILE_GEOMETRY_INPUTS.map(String::from));
             }
             if task.dimension() == 3 {
                 // Spec §9: latent width 128.
@@ -138,6 +142,8 @@ pub fn run_config(
 
 #[cfg(test)]
 mod tests {
+    use amber_tasks::part::GEOMETRY_INPUTS;
+
     use super::*;
 
     #[test]
@@ -156,6 +162,7 @@ mod tests {
             assert_eq!(inputs[0], LOG_SIZE_COLUMN, "{profile:?}");
             let geometric = inputs[1..].iter().all(|i| GEOMETRY_INPUTS.contains(&i.as_str()));
             assert!(geometric && inputs.len() == if profile == Profile::Paper { 1 } else { 4 }, "{profile:?}");
+            assert!(PROFILE_GEOMETRY_INPUTS.iter().all(|i| GEOMETRY_INPUTS.contains(i)));
             let (mut console, mut folder) =
                 (amber_config(Task::Console, profile), amber_config(Task::Folder { dimension: 3 }, profile));
             (console.inputs, folder.inputs) = (Vec::new(), Vec::new());

@@ -245,7 +245,9 @@ impl PolygonDomain {
 /// 2D counterpart of [`crate::mesh3d::SurfaceDistance`].
 #[derive(Clone, Debug)]
 pub struct PolygonDistance {
-    edges: RTree<Line<[f64; 2]>>,
+    /// Every boundary edge with the boundary's radius of curvature there (see
+    /// [`PolygonDistance::curvature_radius`]).
+    edges: RTree<GeomWithData<Line<[f64; 2]>, f64>>,
     /// The vertices where the boundary turns by more than [`CORNER_TURN`], each with its turn
     /// (positive where the domain is convex, negative at a re-entrant corner).
     corners: RTree<GeomWithData<[f64; 2], f64>>,
@@ -265,14 +267,24 @@ impl PolygonDistance {
             // Walking with the domain on the left: the outer ring anticlockwise, holes clockwise.
             let sign = if r == 0 { outer_sign } else { -ring_area(ring).signum() };
             let n = ring.len();
-            for (i, &v) in ring.iter().enumerate() {
-                let (prev, next) = (ring[(i + n - 1) % n], ring[(i + 1) % n]);
-                edges.push(Line::new(v, next));
-                let (a, b) = ([v[0] - prev[0], v[1] - prev[1]], [next[0] - v[0], next[1] - v[1]]);
-                let turn = sign * (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
-                if turn.abs() > CORNER_TURN {
-                    corners.push(GeomWithData::new(v, turn));
-                }
+            // The curvature at each vertex of a smooth stretch: its turn over the mean length of
+            // its two edges (1/r on a polygon inscribed in a circle of radius r); corners are
+            // features, not curvature.
+            let curvature: Vec<f64> = (0..n)
+                .map(|i| {
+                    let (prev, v, next) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+                    let (a, b) = ([v[0] - prev[0], v[1] - prev[1]], [next[0] - v[0], next[1] - v[1]]);
+                    let turn = sign * (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
+                    if turn.abs() > CORNER_TURN {
+                        corners.push(GeomWithData::new(v, turn));
+                        return 0.0;
+                    }
+                    2.0 * turn.abs() / (a[0].hypot(a[1]) + b[0].hypot(b[1]))
+                })
+                .collect();
+            for i in 0..n {
+                let radius = 1.0 / curvature[i].max(curvature[(i + 1) % n]);
+                edges.push(GeomWithData::new(Line::new(ring[i], ring[(i + 1) % n]), radius));
             }
         }
         Self { edges: RTree::bulk_load(edges), corners: RTree::bulk_load(corners) }
@@ -281,6 +293,12 @@ impl PolygonDistance {
     /// The distance from `p` to the boundary.
     pub fn to_boundary(&self, p: [f64; 2]) -> f64 {
         self.edges.nearest_neighbor(p).map_or(f64::INFINITY, |e| e.distance_2(&p).sqrt())
+    }
+
+    /// The boundary's radius of curvature at the boundary point nearest to `p`: of the circle
+    /// through the smooth (non-corner) vertices there, infinite along straight edges.
+    pub fn curvature_radius(&self, p: [f64; 2]) -> f64 {
+        self.edges.nearest_neighbor(p).map_or(f64::INFINITY, |e| e.data)
     }
 
     /// The distance from `p` to the nearest corner and how far the boundary turns there (in
@@ -420,6 +438,26 @@ mod tests {
         assert!((d.area() - 0.5).abs() < 1e-15);
         let bowtie = r#"{"outer": [[0,0],[1,1],[1,0],[0,1]]}"#;
         assert!(serde_json::from_str::<PolygonDomain>(bowtie).unwrap_err().to_string().contains("self-intersecting"));
+    }
+
+    /// Near a round hole the boundary's radius of curvature is the hole's; along the square's
+    /// straight sides (between corners) it is infinite.
+    #[test]
+    fn a_round_hole_has_its_radius_of_curvature() {
+        let square = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let hole = (0..48)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * f64::from(k) / 48.0;
+                [0.5 + 0.1 * angle.cos(), 0.5 + 0.1 * angle.sin()]
+            })
+            .collect();
+        let distance = PolygonDistance::new(&PolygonDomain::new(square, vec![hole]).unwrap());
+        for p in [[0.65, 0.5], [0.5, 0.38], [0.4, 0.6]] {
+            let radius = distance.curvature_radius(p);
+            assert!((radius - 0.1).abs() < 1e-3, "{p:?}: {radius}");
+        }
+        assert!(distance.to_corner([0.62, 0.5]).unwrap().0 > 0.3, "a 48-gon has no corners");
+        assert_eq!(distance.curvature_radius([0.5, 0.05]), f64::INFINITY);
     }
 
     /// The L-shape turns a quarter left at its five convex corners and a quarter right at the

@@ -92,25 +92,31 @@ pub(crate) fn polygon_domain_of_mesh(path: &Path, mesh: &Mesh2) -> Result<Polygo
 /// The optional node inputs a geometry-only domain offers (see [`Domain::optional_inputs`]):
 /// the log distance from each element's midpoint to the boundary and to the nearest feature (a
 /// curve where two CAD faces meet in 3D, a corner in 2D), and how far the boundary turns at that
-/// feature (radians). They come from the geometry alone, so every dataset has them.
-pub const GEOMETRY_INPUTS: [&str; 3] = ["log_boundary_distance", "log_feature_distance", "feature_turn"];
+/// feature (radians), and the log radius of curvature of the boundary nearest to the midpoint
+/// (within a CAD face in 3D, between corners in 2D; capped at the geometry's extent: a round hole
+/// shows its radius, a flat face or straight edge the cap). They come from the geometry alone, so
+/// every dataset has them.
+pub const GEOMETRY_INPUTS: [&str; 4] =
+    ["log_boundary_distance", "log_feature_distance", "feature_turn", "log_curvature_radius"];
 
 /// The columns of [`GEOMETRY_INPUTS`] for elements with midpoints `midpoints`, given the distance
-/// to the boundary and to the nearest feature (with its turn) of a point. Distances are floored
-/// at 10⁻⁶ of the geometry's extent `extent` before the logarithm; without features, the
-/// feature lies at `extent` and turns by 0.
+/// to the boundary and to the nearest feature (with its turn) of a point, and the boundary's
+/// radius of curvature nearest to it. Lengths are clamped to [10⁻⁶, 1] × the geometry's extent
+/// `extent` before the logarithm; without features, the feature lies at `extent` and turns by 0.
 fn geometry_columns<const D: usize>(
     midpoints: &[[f64; D]],
     extent: f64,
     to_boundary: impl Fn([f64; D]) -> f64 + Sync,
     to_feature: impl Fn([f64; D]) -> Option<(f64, f64)> + Sync,
+    curvature_radius: impl Fn([f64; D]) -> f64 + Sync,
 ) -> Vec<Column> {
     let floor = 1e-6 * extent;
-    let rows: Vec<[f64; 3]> = midpoints
+    let rows: Vec<[f64; 4]> = midpoints
         .par_iter()
         .map(|&p| {
             let (to_feature, turn) = to_feature(p).unwrap_or((extent, 0.0));
-            [to_boundary(p).max(floor).ln(), to_feature.max(floor).ln(), turn]
+            let radius = curvature_radius(p).clamp(floor, extent);
+            [to_boundary(p).max(floor).ln(), to_feature.max(floor).ln(), turn, radius.ln()]
         })
         .collect();
     GEOMETRY_INPUTS
@@ -237,8 +243,13 @@ impl Domain<3> for SolidPart {
     /// computed by the graph.
     fn columns(&self, mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
         let (midpoints, distance, extent) = (mesh.midpoints(), &self.distance, self.extent);
-        let mut columns =
-            geometry_columns(&midpoints, extent, |p| distance.to_surface(p), |p| distance.to_feature_curve(p));
+        let mut columns = geometry_columns(
+            &midpoints,
+            extent,
+            |p| distance.to_surface(p),
+            |p| distance.to_feature_curve(p),
+            |p| distance.curvature_radius(p),
+        );
         columns.extend(self.inputs.columns(&midpoints, extent));
         Ok(columns)
     }
@@ -294,7 +305,13 @@ impl Domain<2> for PlanarPart {
     /// computed by the graph.
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
         let (midpoints, distance, extent) = (mesh.midpoints(), &self.distance, self.extent);
-        let mut columns = geometry_columns(&midpoints, extent, |p| distance.to_boundary(p), |p| distance.to_corner(p));
+        let mut columns = geometry_columns(
+            &midpoints,
+            extent,
+            |p| distance.to_boundary(p),
+            |p| distance.to_corner(p),
+            |p| distance.curvature_radius(p),
+        );
         columns.extend(self.inputs.columns(&midpoints, extent));
         Ok(columns)
     }
@@ -320,7 +337,9 @@ mod tests {
         let columns = part.columns(&part.initial_mesh).unwrap();
         let names: Vec<&str> = columns.iter().map(|c| c.name.as_str()).collect();
         assert_eq!(names, GEOMETRY_INPUTS);
-        let [boundary, feature, turn] = [0, 1, 2].map(|i| &columns[i].values);
+        let [boundary, feature, turn, radius] = [0, 1, 2, 3].map(|i| &columns[i].values);
+        // The L-shape's sides are straight: its curvature radius is the cap everywhere.
+        assert!(radius.iter().all(|&r| (r - part.extent.ln()).abs() < 1e-12));
         assert!(boundary.iter().all(|v| v.is_finite()) && boundary.len() == part.initial_mesh.num_elements());
         assert!(boundary.iter().zip(feature).all(|(b, f)| b <= f));
         let distance_to_reentrant = |e: usize| {

@@ -11,7 +11,9 @@ use super::surface::Surface;
 /// R-trees over a surface's triangles and its feature curves, for exact nearest-distance queries.
 #[derive(Clone, Debug)]
 pub struct SurfaceDistance {
-    triangles: RTree<RefTriangle>,
+    /// Every triangle with the surface's radius of curvature there (see
+    /// [`SurfaceDistance::curvature_radius`]).
+    triangles: RTree<GeomWithData<RefTriangle, f64>>,
     /// The edges between two different CAD faces, each with the angle between its two faces'
     /// normals (0: the faces continue tangentially, π/2: a right-angled bend).
     curves: RTree<GeomWithData<Line<[f64; 3]>, f64>>,
@@ -29,15 +31,41 @@ impl SurfaceDistance {
                 GeomWithData::new(Line::new(v[a as usize], v[b as usize]), turn)
             })
             .collect();
-        Self {
-            triangles: RTree::bulk_load(t.iter().map(|tri| RefTriangle(corners(tri))).collect()),
-            curves: RTree::bulk_load(curves),
+        // The curvature across an edge inside a CAD face: the angle between its two triangles'
+        // normals over half the distance, across the edge, between their vertices opposite it
+        // (the part along the edge removed, for the long thin triangles along a cylinder's
+        // axis): 1/r across a cylinder of radius r cut into strips. A triangle takes the
+        // largest of its edges'. Edges between faces are features, not curvature.
+        let opposite = |k: usize, a: u32, b: u32| {
+            let far = t[k].into_iter().find(|&i| i != a && i != b).unwrap_or(a);
+            Vector3::from(v[far as usize])
+        };
+        let mut curvature = vec![0.0f64; t.len()];
+        for ([a, b], [k, l]) in surface.smooth_edges() {
+            let angle = unit_normal(corners(&t[k])).dot(&unit_normal(corners(&t[l]))).clamp(-1.0, 1.0).acos();
+            let along = (Vector3::from(v[b as usize]) - Vector3::from(v[a as usize])).try_normalize(0.0);
+            let apart = opposite(k, a, b) - opposite(l, a, b);
+            let apart = along.map_or(apart, |e| apart - e * apart.dot(&e));
+            let across = angle / (0.5 * apart.norm());
+            if across.is_finite() {
+                curvature[k] = curvature[k].max(across);
+                curvature[l] = curvature[l].max(across);
+            }
         }
+        let triangles =
+            t.iter().zip(&curvature).map(|(tri, &c)| GeomWithData::new(RefTriangle(corners(tri)), 1.0 / c)).collect();
+        Self { triangles: RTree::bulk_load(triangles), curves: RTree::bulk_load(curves) }
     }
 
     /// The distance from `p` to the surface.
     pub fn to_surface(&self, p: [f64; 3]) -> f64 {
         self.triangles.nearest_neighbor(p).map_or(f64::INFINITY, |t| t.distance_2(&p).sqrt())
+    }
+
+    /// The surface's radius of curvature at the surface point nearest to `p` (the largest
+    /// principal curvature's, within a CAD face): infinite on a flat face.
+    pub fn curvature_radius(&self, p: [f64; 3]) -> f64 {
+        self.triangles.nearest_neighbor(p).map_or(f64::INFINITY, |t| t.data)
     }
 
     /// The distance from `p` to the nearest feature curve and the angle between the normals of
@@ -122,6 +150,34 @@ mod tests {
         assert_eq!(t.closest([1.0, -5.0, 0.0]), [1.0, 0.0, 0.0]);
         assert_eq!(t.closest([2.0, 2.0, 0.0]), [1.0, 1.0, 0.0]);
         assert_eq!(t.distance_2(&[0.5, 0.5, 3.0]), 9.0);
+    }
+
+    /// A closed cylinder of radius 0.2 and height 1 (side, bottom and top as three CAD faces,
+    /// 64 long thin triangles around): near the side the radius of curvature is the cylinder's,
+    /// near a flat cap infinite.
+    #[test]
+    fn a_cylinder_has_its_radius_of_curvature() {
+        let n = 64u32;
+        let ring = |z: f64| {
+            (0..n).map(move |k| {
+                let angle = std::f64::consts::TAU * f64::from(k) / f64::from(n);
+                [0.2 * angle.cos(), 0.2 * angle.sin(), z]
+            })
+        };
+        let mut vertices: Vec<[f64; 3]> = ring(0.0).chain(ring(1.0)).collect();
+        vertices.extend([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
+        let (mut triangles, mut faces) = (Vec::new(), Vec::new());
+        for k in 0..n {
+            let (a0, a1, b0, b1) = (k, (k + 1) % n, n + k, n + (k + 1) % n);
+            triangles.extend([[a0, a1, b1], [a0, b1, b0], [2 * n, a1, a0], [2 * n + 1, b0, b1]]);
+            faces.extend([1, 1, 2, 3]);
+        }
+        let distance = SurfaceDistance::new(&Surface::new(vertices, triangles, faces).unwrap());
+        for p in [[0.15, 0.0, 0.5], [0.0, -0.18, 0.3], [0.1, 0.1, 0.45]] {
+            let radius = distance.curvature_radius(p);
+            assert!((radius - 0.2).abs() < 0.01, "{p:?}: {radius}");
+        }
+        assert_eq!(distance.curvature_radius([0.0, 0.0, 0.95]), f64::INFINITY);
     }
 
     /// The unit cube has a CAD face per side: its feature curves are its 12 edges, where faces meet

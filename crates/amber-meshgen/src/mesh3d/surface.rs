@@ -259,6 +259,15 @@ impl Surface {
         by_edge
     }
 
+    /// The edges inside a CAD face (two triangles of the same face around them), in order, each
+    /// with its two triangles.
+    pub fn smooth_edges(&self) -> impl Iterator<Item = ([u32; 2], [usize; 2])> + '_ {
+        self.edge_triangles().into_iter().filter_map(|(edge, around)| match around[..] {
+            [k, l] if self.face_ids[k] == self.face_ids[l] => Some((edge, [k, l])),
+            _ => None,
+        })
+    }
+
     /// The edges between two CAD faces (the feature curves' pieces), in order: each edge's
     /// vertices and its two triangles.
     pub fn feature_edges(&self) -> impl Iterator<Item = ([u32; 2], [usize; 2])> + '_ {

@@ -127,6 +127,36 @@ mod tests {
         assert_eq!(val, ["val/001", "val/002"]);
     }
 
+    /// train/014 is a bent plate with a round hole, where its expert refines most:
+    /// `log_curvature_radius` marks the hole. Its finest 5 % of expert elements lie where the
+    /// nearest surface's radius of curvature is at most a fifth of the median element's (whose
+    /// nearest surface is flat: the cap, the part's extent).
+    #[test]
+    fn the_curvature_input_marks_where_the_expert_refines() {
+        let Some(data) = amber_testdata::shared("data/console") else { return };
+        let mut experts = read_experts::<3>(&Split::Train.dir(&data), Some(14)).unwrap();
+        let expert = experts.pop().unwrap();
+        assert_eq!(expert.name, "train/014");
+        let part = problems::<3, SolidPart>(vec![expert], INITIAL_SIZE, &DatasetSettings::default()).unwrap().remove(0);
+        let columns = part.domain.columns(part.expert_mesh()).unwrap();
+        let radius = &columns.iter().find(|c| c.name == "log_curvature_radius").unwrap().values;
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        let sizes = part.expert_mesh().sizes();
+        let cut = {
+            let mut sorted = sizes.clone();
+            sorted.sort_by(f64::total_cmp);
+            sorted[sorted.len() / 20]
+        };
+        let finest = median((0..sizes.len()).filter(|&e| sizes[e] <= cut).map(|e| radius[e]).collect());
+        let all = median(radius.clone());
+        let cap = radius.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(all, cap, "flat at the median element");
+        assert!(finest < all - 5f64.ln(), "log radius {finest} at the finest elements, {all} at the median");
+    }
+
     /// val/002 through the folder loader: its reference surface, a uniform M⁰, the expert; then
     /// one generation step from M⁰ with a smoke-size field (3 mm everywhere): a new mesh of the
     /// same solid with about the expected element count, its graph and labels; and a field far
