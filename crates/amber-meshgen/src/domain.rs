@@ -246,7 +246,7 @@ impl PolygonDomain {
 #[derive(Clone, Debug)]
 pub struct PolygonDistance {
     /// Every boundary edge with the boundary's radius of curvature there (see
-    /// [`PolygonDistance::curvature_radius`]).
+    /// [`PolygonDistance::to_boundary`]).
     edges: RTree<GeomWithData<Line<[f64; 2]>, f64>>,
     /// The vertices where the boundary turns by more than [`CORNER_TURN`], each with its turn
     /// (positive where the domain is convex, negative at a re-entrant corner).
@@ -290,15 +290,11 @@ impl PolygonDistance {
         Self { edges: RTree::bulk_load(edges), corners: RTree::bulk_load(corners) }
     }
 
-    /// The distance from `p` to the boundary.
-    pub fn to_boundary(&self, p: [f64; 2]) -> f64 {
-        self.edges.nearest_neighbor(p).map_or(f64::INFINITY, |e| e.distance_2(&p).sqrt())
-    }
-
-    /// The boundary's radius of curvature at the boundary point nearest to `p`: of the circle
-    /// through the smooth (non-corner) vertices there, infinite along straight edges.
-    pub fn curvature_radius(&self, p: [f64; 2]) -> f64 {
-        self.edges.nearest_neighbor(p).map_or(f64::INFINITY, |e| e.data)
+    /// The distance from `p` to the boundary and the boundary's radius of curvature at the
+    /// boundary point nearest to `p`: of the circle through the smooth (non-corner) vertices
+    /// there, infinite along straight edges.
+    pub fn to_boundary(&self, p: [f64; 2]) -> (f64, f64) {
+        self.edges.nearest_neighbor(p).map_or((f64::INFINITY, f64::INFINITY), |e| (e.distance_2(&p).sqrt(), e.data))
     }
 
     /// The distance from `p` to the nearest corner and how far the boundary turns there (in
@@ -453,11 +449,11 @@ mod tests {
             .collect();
         let distance = PolygonDistance::new(&PolygonDomain::new(square, vec![hole]).unwrap());
         for p in [[0.65, 0.5], [0.5, 0.38], [0.4, 0.6]] {
-            let radius = distance.curvature_radius(p);
+            let (_, radius) = distance.to_boundary(p);
             assert!((radius - 0.1).abs() < 1e-3, "{p:?}: {radius}");
         }
         assert!(distance.to_corner([0.62, 0.5]).unwrap().0 > 0.3, "a 48-gon has no corners");
-        assert_eq!(distance.curvature_radius([0.5, 0.05]), f64::INFINITY);
+        assert_eq!(distance.to_boundary([0.5, 0.05]), (0.05, f64::INFINITY));
     }
 
     /// The L-shape turns a quarter left at its five convex corners and a quarter right at the
@@ -469,7 +465,7 @@ mod tests {
         for domain in [lshape, reversed] {
             let distance = PolygonDistance::new(&domain);
             let p = [0.45, 0.6];
-            assert!((distance.to_boundary(p) - 0.05).abs() < 1e-12);
+            assert!((distance.to_boundary(p).0 - 0.05).abs() < 1e-12);
             let (to_corner, turn) = distance.to_corner(p).unwrap();
             assert!((to_corner - 0.0125f64.sqrt()).abs() < 1e-12);
             assert!((turn + std::f64::consts::FRAC_PI_2).abs() < 1e-12);

@@ -100,23 +100,24 @@ pub const GEOMETRY_INPUTS: [&str; 4] =
     ["log_boundary_distance", "log_feature_distance", "feature_turn", "log_curvature_radius"];
 
 /// The columns of [`GEOMETRY_INPUTS`] for elements with midpoints `midpoints`, given the distance
-/// to the boundary and to the nearest feature (with its turn) of a point, and the boundary's
-/// radius of curvature nearest to it. Lengths are clamped to [10⁻⁶, 1] × the geometry's extent
-/// `extent` before the logarithm; without features, the feature lies at `extent` and turns by 0.
+/// to the boundary of a point with the boundary's radius of curvature there, and its distance to
+/// the nearest feature with the feature's turn. Lengths are clamped to [10⁻⁶, 1] × the
+/// geometry's extent `extent` before the logarithm; without features, the feature lies at
+/// `extent` and turns by 0.
 fn geometry_columns<const D: usize>(
     midpoints: &[[f64; D]],
     extent: f64,
-    to_boundary: impl Fn([f64; D]) -> f64 + Sync,
+    to_boundary: impl Fn([f64; D]) -> (f64, f64) + Sync,
     to_feature: impl Fn([f64; D]) -> Option<(f64, f64)> + Sync,
-    curvature_radius: impl Fn([f64; D]) -> f64 + Sync,
 ) -> Vec<Column> {
     let floor = 1e-6 * extent;
     let rows: Vec<[f64; 4]> = midpoints
         .par_iter()
         .map(|&p| {
+            let (to_boundary, radius) = to_boundary(p);
             let (to_feature, turn) = to_feature(p).unwrap_or((extent, 0.0));
-            let radius = curvature_radius(p).clamp(floor, extent);
-            [to_boundary(p).max(floor).ln(), to_feature.max(floor).ln(), turn, radius.ln()]
+            let radius = radius.clamp(floor, extent);
+            [to_boundary.max(floor).ln(), to_feature.max(floor).ln(), turn, radius.ln()]
         })
         .collect();
     GEOMETRY_INPUTS
@@ -243,13 +244,8 @@ impl Domain<3> for SolidPart {
     /// computed by the graph.
     fn columns(&self, mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
         let (midpoints, distance, extent) = (mesh.midpoints(), &self.distance, self.extent);
-        let mut columns = geometry_columns(
-            &midpoints,
-            extent,
-            |p| distance.to_surface(p),
-            |p| distance.to_feature_curve(p),
-            |p| distance.curvature_radius(p),
-        );
+        let mut columns =
+            geometry_columns(&midpoints, extent, |p| distance.to_surface(p), |p| distance.to_feature_curve(p));
         columns.extend(self.inputs.columns(&midpoints, extent));
         Ok(columns)
     }
@@ -305,13 +301,7 @@ impl Domain<2> for PlanarPart {
     /// computed by the graph.
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
         let (midpoints, distance, extent) = (mesh.midpoints(), &self.distance, self.extent);
-        let mut columns = geometry_columns(
-            &midpoints,
-            extent,
-            |p| distance.to_boundary(p),
-            |p| distance.to_corner(p),
-            |p| distance.curvature_radius(p),
-        );
+        let mut columns = geometry_columns(&midpoints, extent, |p| distance.to_boundary(p), |p| distance.to_corner(p));
         columns.extend(self.inputs.columns(&midpoints, extent));
         Ok(columns)
     }

@@ -12,7 +12,7 @@ use super::surface::Surface;
 #[derive(Clone, Debug)]
 pub struct SurfaceDistance {
     /// Every triangle with the surface's radius of curvature there (see
-    /// [`SurfaceDistance::curvature_radius`]).
+    /// [`SurfaceDistance::to_surface`]).
     triangles: RTree<GeomWithData<RefTriangle, f64>>,
     /// The edges between two different CAD faces, each with the angle between its two faces'
     /// normals (0: the faces continue tangentially, π/2: a right-angled bend).
@@ -57,15 +57,11 @@ impl SurfaceDistance {
         Self { triangles: RTree::bulk_load(triangles), curves: RTree::bulk_load(curves) }
     }
 
-    /// The distance from `p` to the surface.
-    pub fn to_surface(&self, p: [f64; 3]) -> f64 {
-        self.triangles.nearest_neighbor(p).map_or(f64::INFINITY, |t| t.distance_2(&p).sqrt())
-    }
-
-    /// The surface's radius of curvature at the surface point nearest to `p` (the largest
-    /// principal curvature's, within a CAD face): infinite on a flat face.
-    pub fn curvature_radius(&self, p: [f64; 3]) -> f64 {
-        self.triangles.nearest_neighbor(p).map_or(f64::INFINITY, |t| t.data)
+    /// The distance from `p` to the surface and the surface's radius of curvature at the surface
+    /// point nearest to `p` (the largest principal curvature's, within a CAD face): infinite on
+    /// a flat face.
+    pub fn to_surface(&self, p: [f64; 3]) -> (f64, f64) {
+        self.triangles.nearest_neighbor(p).map_or((f64::INFINITY, f64::INFINITY), |t| (t.distance_2(&p).sqrt(), t.data))
     }
 
     /// The distance from `p` to the nearest feature curve and the angle between the normals of
@@ -174,10 +170,10 @@ mod tests {
         }
         let distance = SurfaceDistance::new(&Surface::new(vertices, triangles, faces).unwrap());
         for p in [[0.15, 0.0, 0.5], [0.0, -0.18, 0.3], [0.1, 0.1, 0.45]] {
-            let radius = distance.curvature_radius(p);
+            let (_, radius) = distance.to_surface(p);
             assert!((radius - 0.2).abs() < 0.01, "{p:?}: {radius}");
         }
-        assert_eq!(distance.curvature_radius([0.0, 0.0, 0.95]), f64::INFINITY);
+        assert_eq!(distance.to_surface([0.0, 0.0, 0.95]).1, f64::INFINITY);
     }
 
     /// The unit cube has a CAD face per side: its feature curves are its 12 edges, where faces meet
@@ -186,12 +182,12 @@ mod tests {
     fn distances_inside_the_unit_cube() {
         let distance = SurfaceDistance::new(&unit_cube());
         let centre = [0.5, 0.5, 0.5];
-        assert!((distance.to_surface(centre) - 0.5).abs() < 1e-12);
+        assert!((distance.to_surface(centre).0 - 0.5).abs() < 1e-12);
         let (to_curve, turn) = distance.to_feature_curve(centre).unwrap();
         assert!((to_curve - 0.5 * 2f64.sqrt()).abs() < 1e-12);
         assert!((turn - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         let near_an_edge = [0.1, 0.2, 0.5];
-        assert!((distance.to_surface(near_an_edge) - 0.1).abs() < 1e-12);
+        assert!((distance.to_surface(near_an_edge).0 - 0.1).abs() < 1e-12);
         assert!((distance.to_feature_curve(near_an_edge).unwrap().0 - 0.05f64.sqrt()).abs() < 1e-12);
     }
 }
