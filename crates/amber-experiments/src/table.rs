@@ -4,6 +4,8 @@
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
+use amber_stdx::median;
+
 use crate::results::{ExperimentResults, RunResult};
 
 /// The paper's normalised DCD of a row (method label) and column (difficulty or setting), where
@@ -42,6 +44,15 @@ pub fn row_label(run: &RunResult) -> String {
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     sum / n.max(1) as f64
+}
+
+/// Each problem's final element count over its expert's, over every problem of `runs`: the median
+/// [smallest, largest], or a dash without problems.
+fn element_ratios(runs: &[&RunResult]) -> String {
+    let ratios: Vec<f64> =
+        runs.iter().flat_map(|r| &r.problems).map(|p| p.last().elements as f64 / p.expert_elements as f64).collect();
+    let (low, high) = ratios.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &r| (l.min(r), h.max(r)));
+    if ratios.is_empty() { "–".into() } else { format!("{:.2} [{low:.2}, {high:.2}]", median(&ratios)) }
 }
 
 /// The Markdown of both tables.
@@ -102,13 +113,14 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
     let _ = writeln!(
         md,
         "\n## Raw numbers\n\nMeans over the evaluated problems and seeds: raw DCD of the final mesh d(Mᵀ), of M⁰ and of the \
-         reconstruction M̂ to the expert; normalised DCD per generation step; elements (expert); failed or \
-         over-budget generation steps (summed); training and evaluation wall time.\n"
+         reconstruction M̂ to the expert; normalised DCD per generation step; elements (expert); each \
+         problem's final elements over its expert's, median [smallest, largest]; failed or over-budget \
+         generation steps (summed); training and evaluation wall time.\n"
     );
     let _ = writeln!(
         md,
-        "| method | setting | d(Mᵀ) | d(M⁰) | d(M̂) | nDCD per step | elements (expert) | volume diff. | failed steps | \
-         train s | eval s |\n|---|---|---|---|---|---|---|---|---|---|---|"
+        "| method | setting | d(Mᵀ) | d(M⁰) | d(M̂) | nDCD per step | elements (expert) | elements / expert's | \
+         volume diff. | failed steps | train s | eval s |\n|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for row in &rows {
         for c in &columns {
@@ -116,9 +128,10 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
             let steps = runs.iter().map(|r| r.ndcd_per_step.len()).min().unwrap_or(0);
             let per_step: Vec<String> =
                 (0..steps).map(|t| format!("{:.3}", mean(runs.iter().map(|r| r.ndcd_per_step[t])))).collect();
+            let ratios = element_ratios(runs);
             let _ = writeln!(
                 md,
-                "| {row} | {c} | {:.4} | {:.4} | {:.4} | {} | {:.0} ({:.0}) | {:.3e} | {} | {:.0} | {:.0} |",
+                "| {row} | {c} | {:.4} | {:.4} | {:.4} | {} | {:.0} ({:.0}) | {ratios} | {:.3e} | {} | {:.0} | {:.0} |",
                 mean(runs.iter().map(|r| r.dcd)),
                 mean(runs.iter().map(|r| r.dcd_initial)),
                 mean(runs.iter().map(|r| r.dcd_reconstruction)),
@@ -134,4 +147,41 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
     }
     let _ = writeln!(md, "\nCommit `{}`; machine: {}.", results.commit, results.machine);
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use amber_train::{MeshMetrics, StepStatus};
+
+    use super::*;
+    use crate::results::{ProblemEvaluation, RunKey, StepEvaluation};
+
+    fn problem(elements: usize, expert_elements: usize) -> ProblemEvaluation {
+        let metrics = MeshMetrics { dcd: 0.1, normalised_dcd: 0.1, chamfer: 0.0, volume_difference: 0.0, elements };
+        ProblemEvaluation {
+            name: None,
+            expert_sha256: None,
+            initial: metrics,
+            steps: vec![StepEvaluation { status: StepStatus::Meshed, metrics }],
+            initial_dcd: 0.5,
+            reconstruction_dcd: 0.0,
+            expert_elements,
+        }
+    }
+
+    #[test]
+    fn the_element_ratio_column_spans_every_problem_of_every_seed() {
+        let key = |seed| RunKey {
+            method: "amber",
+            variant: "default",
+            difficulty: "console",
+            seed,
+            train_seconds: 0.0,
+            eval_seconds: 0.0,
+        };
+        let first = RunResult::new(key(0), &[problem(90, 100), problem(300, 200)]);
+        let second = RunResult::new(key(1), &[problem(50, 100)]);
+        assert_eq!(element_ratios(&[&first, &second]), "0.90 [0.50, 1.50]");
+        assert_eq!(element_ratios(&[]), "–");
+    }
 }
