@@ -31,10 +31,11 @@ pub struct Args {
     /// Directed edges besides the self-loops (about 3 neighbours per node by default).
     #[arg(long, default_value_t = 150_000)]
     pub edges: usize,
-    /// Nodes for the naive training step, which keeps about 0.75 MB per node: 10,000 need 7.6 GB,
-    /// the 50,000 of the other cases were killed for memory on a 24 GB machine.
-    #[arg(long, default_value_t = 10_000)]
-    pub naive_nodes: usize,
+    /// Nodes for the naive training step, which keeps about 12 kB per node and unit of D (at
+    /// D = 64: 10,000 nodes need 7.6 GB, the 50,000 of the other cases were killed for memory on
+    /// a 24 GB machine). Default: 640,000 / D.
+    #[arg(long)]
+    pub naive_nodes: Option<usize>,
     /// Variants to time: naive (stock candle ops), fast (fused ops), fast-dropout (training step of
     /// the fused ops with the training-mode edge dropout of 0.1).
     #[arg(long, value_delimiter = ',', default_value = "fast,fast-dropout,naive")]
@@ -62,12 +63,18 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let config = MpnConfig::small(args.latent, MpnConfig::poisson().network.message_passing_steps);
     let paper = TrainingConfig::paper();
+    let naive_nodes = args.naive_nodes.unwrap_or(640_000 / args.latent.max(1));
+    // The peer first: after the naive training step this process keeps its peak memory, and at
+    // D = 128 the two together were killed for memory on a 24 GB machine.
+    let peer = match &args.peer_python {
+        Some(python) => Some(run_peer(python, &args)?),
+        None => None,
+    };
     let mut cases = Vec::new();
     for variant in &args.variants {
         // Dropout only exists in training.
         for mode in args.modes.iter().filter(|m| !(variant == "fast-dropout" && *m == "infer")) {
-            let nodes =
-                if variant == "naive" && mode == "train" { args.naive_nodes.min(args.nodes) } else { args.nodes };
+            let nodes = if variant == "naive" && mode == "train" { naive_nodes.min(args.nodes) } else { args.nodes };
             let edges = args.edges * nodes / args.nodes;
             let case = bench_case(&config, &paper, variant, mode, nodes, edges, &args)?;
             println!(
@@ -82,10 +89,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             cases.push(case);
         }
     }
-    let peer = match &args.peer_python {
-        Some(python) => Some(run_peer(python, &args)?),
-        None => None,
-    };
     let result = json!({
         "benchmark": "mpn",
         "config": config,
