@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use amber_fem::ExpertHeuristic;
+use amber_graph::EdgeFeature;
 use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::{INITIAL_SIZE, LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, PoissonProblem};
 use amber_train::{
@@ -259,6 +260,29 @@ fn the_optional_features_reach_a_saved_model_that_predicts_on_new_meshes() {
     let sizes = model.predict(&[&state]).unwrap();
     assert_eq!(sizes[0].len(), problem.expert_mesh.num_elements());
     assert!(sizes[0].iter().all(|h| h.is_finite() && *h > 0.0));
+}
+
+/// A config's edge features replace the task's: the saved model reads them, and predicts with
+/// them on a mesh it has not seen.
+#[test]
+fn a_configured_edge_feature_set_replaces_the_tasks() {
+    let edge_features = vec![EdgeFeature::MidpointDifference, EdgeFeature::MidpointDistance];
+    let config = TrainingConfig { edge_features: Some(edge_features.clone()), ..tiny_config(2) };
+    let problems = problems(&[11, 12]);
+    let mut training = Training::new(config, problems.clone()).unwrap();
+    training.train_step().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    training.save_model(dir.path()).unwrap();
+    let model = AmberModel::load(dir.path()).unwrap();
+    assert_eq!(model.predictor.features.edge, edge_features);
+    assert_eq!(model.network.config().edge_features, 3, "a 2D difference vector and a distance");
+    let problem = &problems[0];
+    let state = amber_tasks::MeshState::new(problem, &model.predictor.features, problem.expert_mesh.clone()).unwrap();
+    assert!(model.predict(&[&state]).unwrap()[0].iter().all(|h| h.is_finite() && *h > 0.0));
+
+    let none = TrainingConfig { edge_features: Some(Vec::new()), ..tiny_config(2) };
+    let Err(error) = Training::new(none, problems) else { panic!("trained without edge features") };
+    assert!(error.to_string().contains("edge_features"), "{error}");
 }
 
 #[cfg(not(feature = "cuda"))]

@@ -1,6 +1,6 @@
 //! Every knob of an AMBER training run ([`TrainingConfig`]) and its named profiles.
 
-use amber_graph::Aggregation;
+use amber_graph::{Aggregation, EdgeFeature};
 use amber_mpn::{MpnConfig, NetworkConfig};
 use amber_nn::{Backend, Objective};
 use serde::{Deserialize, Serialize};
@@ -40,6 +40,11 @@ pub struct TrainingConfig {
     /// (log h(K), any task) or one of the task's optional inputs
     /// (`amber_tasks::Problem::optional_inputs`); none in the paper.
     pub inputs: Vec<String>,
+    /// The edge features, replacing the task's own (the paper's: Poisson the midpoint distance,
+    /// Console the 3D midpoint difference vector); e.g. `["midpoint_distance"]` gives Console a
+    /// network that cannot tell a part's orientation. None: the task's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edge_features: Option<Vec<EdgeFeature>>,
     /// The network.
     pub network: NetworkConfig,
     /// Gradient steps.
@@ -110,6 +115,7 @@ impl TrainingConfig {
             normalise_labels: false,
             normalise_inputs: true,
             inputs: Vec::new(),
+            edge_features: None,
             network: NetworkConfig::default(),
             steps: 128_000,
             learning_rate: PAPER_LEARNING_RATE,
@@ -194,6 +200,9 @@ impl TrainingConfig {
         let bad = |m: &str| Err(TrainError::InvalidConfig(m.to_owned()));
         if self.steps == 0 {
             return bad("steps must be positive");
+        }
+        if self.edge_features.as_ref().is_some_and(Vec::is_empty) {
+            return bad("edge_features must name at least one feature (or be left out: the task's)");
         }
         if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
             return bad("learning_rate must be positive");

@@ -100,7 +100,10 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
                 )));
             }
         }
-        let features = with_inputs(first.feature_set(), &config.inputs);
+        let mut features = with_inputs(first.feature_set(), &config.inputs);
+        if let Some(edge) = &config.edge_features {
+            features.edge.clone_from(edge);
+        }
         let limits = MeshLimits::from_experts(
             problems.iter().map(|p| p.expert_mesh()),
             config.budget_factor,
