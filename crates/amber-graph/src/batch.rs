@@ -12,7 +12,9 @@ use crate::{GraphError, MeshGraph};
 ///   the edges arriving at node `v` are `dst_offsets[v]..dst_offsets[v + 1]`, so aggregation is
 ///   a segment operation;
 /// - every node has a self-loop among its incoming edges;
-/// - `graph_of_node[v]` is the graph index of node `v`.
+/// - `graph_of_node[v]` is the graph index of node `v`;
+/// - `region_of_node[v] < num_regions` is the region of node `v` ([`MeshGraph::region_of_node`],
+///   numbered on from the previous graph's), and every region has a node.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GraphBatch {
     pub num_nodes: usize,
@@ -26,6 +28,8 @@ pub struct GraphBatch {
     pub dst_offsets: Vec<u32>,
     pub graph_of_node: Vec<u32>,
     pub node_offsets: Vec<u32>,
+    pub region_of_node: Vec<u32>,
+    pub num_regions: usize,
 }
 
 impl GraphBatch {
@@ -73,6 +77,8 @@ impl GraphBatch {
             dst_offsets: Vec::with_capacity(num_nodes + 1),
             graph_of_node: Vec::with_capacity(num_nodes),
             node_offsets: Vec::with_capacity(graphs.len() + 1),
+            region_of_node: Vec::with_capacity(num_nodes),
+            num_regions: 0,
         };
         batch.dst_offsets.push(0);
         batch.node_offsets.push(0);
@@ -84,6 +90,8 @@ impl GraphBatch {
             batch.edge_dst.extend(g.edge_dst().iter().map(|&d| d + node_base));
             batch.dst_offsets.extend(g.dst_offsets()[1..].iter().map(|&o| o + edge_base));
             batch.graph_of_node.extend(std::iter::repeat_n(index as u32, g.num_nodes()));
+            batch.region_of_node.extend(g.region_of_node().iter().map(|&r| r + batch.num_regions as u32));
+            batch.num_regions += g.num_regions();
             node_base += g.num_nodes() as u32;
             edge_base += g.num_edges() as u32;
             batch.node_offsets.push(node_base);
@@ -94,6 +102,17 @@ impl GraphBatch {
     /// Number of graphs in the batch.
     pub fn num_graphs(&self) -> usize {
         self.node_offsets.len().saturating_sub(1)
+    }
+
+    /// The node count of every region.
+    pub fn region_sizes(&self) -> Vec<usize> {
+        let mut sizes = vec![0; self.num_regions];
+        for &r in &self.region_of_node {
+            if let Some(n) = sizes.get_mut(r as usize) {
+                *n += 1;
+            }
+        }
+        sizes
     }
 
     /// Checks every invariant listed on [`GraphBatch`] (for batches assembled by hand).
@@ -138,6 +157,12 @@ impl GraphBatch {
                 return fail(format!("graph_of_node disagrees with node_offsets for graph {g}"));
             }
         }
+        if self.region_of_node.len() != n || self.region_of_node.iter().any(|&r| r as usize >= self.num_regions) {
+            return fail(format!("region_of_node must give every node a region below {}", self.num_regions));
+        }
+        if let Some(r) = self.region_sizes().iter().position(|&size| size == 0) {
+            return fail(format!("region {r} has no nodes"));
+        }
         Ok(())
     }
 }
@@ -170,6 +195,22 @@ mod tests {
         assert_eq!(&batch.edge_src[a.num_edges()..], &b.edge_src().iter().map(|s| s + 2).collect::<Vec<_>>()[..]);
         assert_eq!(batch.dst_offsets[2] as usize, a.num_edges());
         assert_eq!(&batch.edge_features[..a.edge_features().len()], a.edge_features());
+        // Regions in the grid's order, x major: a's midpoints lie in cells (3, 0) and (0, 3) of
+        // cubes a quarter of 1/3 wide; b's in (1, 0), (0, 1) and (3, 0) of cubes 1/4 wide.
+        assert_eq!((a.region_of_node(), b.region_of_node()), (&[1, 0][..], &[1, 0, 2][..]));
+        assert_eq!((batch.region_of_node.clone(), batch.num_regions), (vec![1, 0, 3, 2, 4], 5));
+    }
+
+    /// Regions are cubes, a quarter of the longest side wide: an 8 × 8 grid of split squares has
+    /// 16 regions of 2 × 2 squares, an 8 × 2 grid 4 (its short side fits in one cube).
+    #[test]
+    fn regions_are_cubes_of_a_quarter_of_the_longest_side() {
+        for ((nx, ny), regions) in [((8, 8), 16), ((8, 2), 4)] {
+            let graph = MeshGraph::new(&grid(nx, ny), &FeatureSet::console(), &[]).unwrap();
+            let batch = GraphBatch::from_graphs([&graph]).unwrap();
+            assert_eq!(batch.num_regions, regions);
+            assert_eq!(batch.region_sizes(), vec![2 * nx * ny / regions; regions]);
+        }
     }
 
     /// An `nx × ny` grid of unit squares, each split into two triangles.
@@ -214,5 +255,17 @@ mod tests {
         // Node 0 receives (0 → 0, 1 → 0); redirect the self-loop's source.
         batch.edge_src[0] = 1;
         assert!(matches!(batch.validate(), Err(GraphError::InvalidBatch { .. })));
+    }
+
+    #[test]
+    fn validation_catches_an_empty_or_unknown_region() {
+        let batch = GraphBatch::from_graphs([&graph(false)]).unwrap();
+        let mut empty = batch.clone();
+        empty.region_of_node = vec![0, 0];
+        let mut unknown = batch;
+        unknown.region_of_node[1] = 2;
+        for bad in [empty, unknown] {
+            assert!(matches!(bad.validate(), Err(GraphError::InvalidBatch { .. })));
+        }
     }
 }

@@ -19,7 +19,13 @@ pub struct MeshGraph {
     edge_src: Vec<u32>,
     edge_dst: Vec<u32>,
     dst_offsets: Vec<u32>,
+    region_of_node: Vec<u32>,
+    num_regions: usize,
 }
+
+/// Cubes along the longest side of a graph's bounding box in its partition into regions (see
+/// [`MeshGraph::region_of_node`]): at most 4² regions in 2D and 4³ in 3D.
+pub const REGIONS_PER_AXIS: usize = 4;
 
 impl MeshGraph {
     /// Builds the graph of `mesh` with the features listed in `features`; `columns` supplies the
@@ -77,6 +83,7 @@ impl MeshGraph {
             }
         }
 
+        let (region_of_node, num_regions) = regions(&midpoints);
         Ok(Self {
             node_dim: features.node_dim(),
             node_features,
@@ -85,6 +92,8 @@ impl MeshGraph {
             edge_src,
             edge_dst,
             dst_offsets,
+            region_of_node,
+            num_regions,
         })
     }
 
@@ -132,6 +141,44 @@ impl MeshGraph {
     pub fn dst_offsets(&self) -> &[u32] {
         &self.dst_offsets
     }
+
+    /// The region of every node: the cell its element's midpoint lies in, of a grid of cubes
+    /// over the midpoints' bounding box with [`REGIONS_PER_AXIS`] cubes along its longest side,
+    /// the non-empty cells numbered in the grid's order (`0..num_regions`).
+    pub fn region_of_node(&self) -> &[u32] {
+        &self.region_of_node
+    }
+
+    /// Number of regions (non-empty cells), each with at least one node.
+    pub fn num_regions(&self) -> usize {
+        self.num_regions
+    }
+}
+
+/// The regions of the elements with midpoints `midpoints` and their count (see
+/// [`MeshGraph::region_of_node`]).
+fn regions<const D: usize>(midpoints: &[[f64; D]]) -> (Vec<u32>, usize) {
+    let Some((low, high)) = amber_mesh::bounding_box(midpoints) else { return (Vec::new(), 0) };
+    let longest = (0..D).map(|k| high[k] - low[k]).fold(0.0, f64::max);
+    let cube = longest / REGIONS_PER_AXIS as f64;
+    let cell = |p: &[f64; D]| {
+        (0..D).fold(0, |index, k| {
+            let along = if cube > 0.0 { ((p[k] - low[k]) / cube) as usize } else { 0 };
+            index * REGIONS_PER_AXIS + along.min(REGIONS_PER_AXIS - 1)
+        })
+    };
+    let cells: Vec<usize> = midpoints.iter().map(cell).collect();
+    let mut used = vec![false; REGIONS_PER_AXIS.pow(D as u32)];
+    cells.iter().for_each(|&c| used[c] = true);
+    let number: Vec<u32> = used
+        .iter()
+        .scan(0, |next, &u| {
+            let n = *next;
+            *next += u32::from(u);
+            Some(n)
+        })
+        .collect();
+    (cells.iter().map(|&c| number[c]).collect(), used.iter().filter(|&&u| u).count())
 }
 
 /// Node feature rows: geometric columns computed here, named columns taken from the caller.

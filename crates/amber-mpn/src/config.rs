@@ -24,11 +24,24 @@ pub struct NetworkConfig {
     /// configurations without it keep their hashes.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub graph_context: bool,
+    /// Region context (off in the paper): every step also adds `tanh(W·mean_R(x) + b)`, the mean
+    /// node state of each node's region transformed (the graph's cell of a grid of about
+    /// `amber_graph::REGIONS_PER_AXIS` cubes along its longest side): a coarse level between
+    /// the element and the whole mesh, so a step sees a region of the part, not ten elements.
+    /// Omitted from the JSON when off.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub region_context: bool,
 }
 
 impl Default for NetworkConfig {
     fn default() -> Self {
-        Self { latent_dim: 64, message_passing_steps: 10, edge_dropout: 0.1, graph_context: false }
+        Self {
+            latent_dim: 64,
+            message_passing_steps: 10,
+            edge_dropout: 0.1,
+            graph_context: false,
+            region_context: false,
+        }
     }
 }
 
@@ -90,11 +103,14 @@ impl MpnConfig {
     }
 
     /// Number of trainable scalars: encoders, L × (edge MLP 3D→D→D, node MLP 2D→D→D, two
-    /// affine LayerNorms, the graph context's D→D if on), decoder D→D→D→1.
+    /// affine LayerNorms, the graph and region contexts' D→D if on), decoder D→D→D→1.
     pub fn num_parameters(&self) -> usize {
         let d = self.network.latent_dim;
         let linear = |i: usize, o: usize| i * o + o;
-        let context = if self.network.graph_context { linear(d, d) } else { 0 };
+        let context = [self.network.graph_context, self.network.region_context]
+            .into_iter()
+            .map(|on| if on { linear(d, d) } else { 0 })
+            .sum::<usize>();
         let step = linear(3 * d, d) + linear(d, d) + linear(2 * d, d) + linear(d, d) + 2 * 2 * d + context;
         linear(self.node_features, d)
             + linear(self.edge_features, d)
@@ -116,6 +132,8 @@ mod tests {
         let mut with_context = MpnConfig::poisson();
         with_context.network.graph_context = true;
         assert_eq!(with_context.num_parameters(), 300_673 + 10 * (64 * 64 + 64));
+        with_context.network.region_context = true;
+        assert_eq!(with_context.num_parameters(), 300_673 + 20 * (64 * 64 + 64));
     }
 
     #[test]
@@ -124,6 +142,7 @@ mod tests {
         let back: MpnConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
         assert_eq!(back, c);
         assert!(!serde_json::to_string(&c).unwrap().contains("graph_context"));
+        assert!(!serde_json::to_string(&c).unwrap().contains("region_context"));
         let mut on = c;
         on.network.graph_context = true;
         assert_eq!(serde_json::from_str::<MpnConfig>(&serde_json::to_string(&on).unwrap()).unwrap(), on);

@@ -120,6 +120,10 @@ pub struct GraphInput {
     pub graph_of_node: Tensor,
     /// One over the node count of every graph (`(G, 1)`, the network's dtype).
     pub inverse_graph_sizes: Tensor,
+    /// The region index of every node (u32, `(N)`; see `amber_graph::GraphBatch`).
+    pub region_of_node: Tensor,
+    /// One over the node count of every region (`(R, 1)`, the network's dtype).
+    pub inverse_region_sizes: Tensor,
 }
 
 impl GraphInput {
@@ -136,6 +140,10 @@ impl GraphInput {
         let inverse_graph_sizes: Vec<f32> = offsets.windows(2).map(|w| 1.0 / (w[1] - w[0]) as f32).collect();
         let inverse_graph_sizes =
             Tensor::from_vec(inverse_graph_sizes, (offsets.len() - 1, 1), device)?.to_dtype(dtype)?;
+        // `validate` checked that every region has a node.
+        let inverse_region_sizes: Vec<f32> = batch.region_sizes().into_iter().map(|n| 1.0 / n as f32).collect();
+        let inverse_region_sizes =
+            Tensor::from_vec(inverse_region_sizes, (batch.num_regions, 1), device)?.to_dtype(dtype)?;
         let topology = Topology::new(n, batch.edge_src.clone(), batch.edge_dst.clone(), batch.dst_offsets.clone())?;
         let node_features = Tensor::from_slice(&batch.node_features, (n, batch.node_dim), device)?.to_dtype(dtype)?;
         let edge_features = Tensor::from_slice(&batch.edge_features, (e, batch.edge_dim), device)?.to_dtype(dtype)?;
@@ -145,6 +153,8 @@ impl GraphInput {
             topology: Arc::new(topology),
             graph_of_node: Tensor::from_slice(&batch.graph_of_node, n, device)?,
             inverse_graph_sizes,
+            region_of_node: Tensor::from_slice(&batch.region_of_node, n, device)?,
+            inverse_region_sizes,
         })
     }
 
@@ -167,6 +177,8 @@ impl GraphInput {
             topology: Arc::new(topology),
             graph_of_node: self.graph_of_node.clone(),
             inverse_graph_sizes: self.inverse_graph_sizes.clone(),
+            region_of_node: self.region_of_node.clone(),
+            inverse_region_sizes: self.inverse_region_sizes.clone(),
         })
     }
 }

@@ -92,25 +92,33 @@ impl ResidualMlp {
     }
 }
 
-/// One message-passing step: edge update (message), mean aggregation, graph context if
-/// configured, node update.
+/// One message-passing step: edge update (message), mean aggregation, graph and region
+/// contexts if configured, node update.
 struct Step {
     edge: ResidualMlp,
     node: ResidualMlp,
     context: Option<Linear>,
+    region_context: Option<Linear>,
 }
 
 impl Step {
     /// The aggregated messages plus, with a graph context, `tanh(W·mean(x) + b)` of each node's
-    /// graph (stock candle ops: the tensors are `(G, D)`, G a handful of graphs).
+    /// graph, and with a region context the same of each node's region (stock candle ops: the
+    /// group tensors are `(G, D)`, G a handful of graphs or a few dozen regions per graph).
     fn with_context(&self, aggregated: Tensor, x: &Tensor, graph: &GraphInput) -> candle_core::Result<Tensor> {
-        let Some(context) = &self.context else {
-            return Ok(aggregated);
-        };
-        let graph_mean = Tensor::zeros((graph.num_graphs(), x.dim(1)?), x.dtype(), x.device())?
-            .index_add(&graph.graph_of_node, x, 0)?
-            .broadcast_mul(&graph.inverse_graph_sizes)?;
-        aggregated + context.forward(&graph_mean)?.tanh()?.index_select(&graph.graph_of_node, 0)?
+        let groups = [
+            (&self.context, &graph.graph_of_node, &graph.inverse_graph_sizes),
+            (&self.region_context, &graph.region_of_node, &graph.inverse_region_sizes),
+        ];
+        let mut out = aggregated;
+        for (linear, group_of_node, inverse_sizes) in groups {
+            let Some(linear) = linear else { continue };
+            let mean = Tensor::zeros((inverse_sizes.dim(0)?, x.dim(1)?), x.dtype(), x.device())?
+                .index_add(group_of_node, x, 0)?
+                .broadcast_mul(inverse_sizes)?;
+            out = (out + linear.forward(&mean)?.tanh()?.index_select(group_of_node, 0)?)?;
+        }
+        Ok(out)
     }
 }
 
@@ -129,7 +137,8 @@ pub struct Mpn {
 impl Mpn {
     /// Builds the network from a `VarBuilder`: parameter names are `node_encoder.weight`,
     /// `steps.{l}.edge.mlp.{0,1}.{weight,bias}`, `steps.{l}.edge.norm.{weight,bias}`, likewise
-    /// `node`, `steps.{l}.context.{weight,bias}` with a graph context, and `decoder.{0,1,2}.*`.
+    /// `node`, `steps.{l}.context.{weight,bias}` with a graph context,
+    /// `steps.{l}.region_context.{weight,bias}` with a region context, and `decoder.{0,1,2}.*`.
     pub fn new(config: MpnConfig, vb: VarBuilder) -> Result<Self> {
         config.validate()?;
         let d = config.network.latent_dim;
@@ -140,6 +149,11 @@ impl Mpn {
                     edge: ResidualMlp::new(vb.pp("edge"), 3 * d, d)?,
                     node: ResidualMlp::new(vb.pp("node"), 2 * d, d)?,
                     context: config.network.graph_context.then(|| Linear::new(vb.pp("context"), d, d)).transpose()?,
+                    region_context: config
+                        .network
+                        .region_context
+                        .then(|| Linear::new(vb.pp("region_context"), d, d))
+                        .transpose()?,
                 })
             })
             .collect::<candle_core::Result<_>>()?;
@@ -228,7 +242,12 @@ impl Mpn {
             steps: self
                 .steps
                 .iter()
-                .map(|s| Step { edge: mlp(&s.edge), node: mlp(&s.node), context: s.context.as_ref().map(linear) })
+                .map(|s| Step {
+                    edge: mlp(&s.edge),
+                    node: mlp(&s.node),
+                    context: s.context.as_ref().map(linear),
+                    region_context: s.region_context.as_ref().map(linear),
+                })
                 .collect(),
             decoder: [linear(&self.decoder[0]), linear(&self.decoder[1]), linear(&self.decoder[2])],
         }
@@ -253,7 +272,7 @@ impl Mpn {
         for s in &self.steps {
             p.extend(s.edge.parameters());
             p.extend(s.node.parameters());
-            p.extend(s.context.iter().flat_map(|l| [&l.weight, &l.bias]));
+            p.extend(s.context.iter().chain(&s.region_context).flat_map(|l| [&l.weight, &l.bias]));
         }
         for l in &self.decoder {
             p.extend([&l.weight, &l.bias]);

@@ -6,7 +6,8 @@ use rand::{Rng, SeedableRng};
 
 /// A single graph of `num_nodes` nodes with `undirected_edges` random node pairs, each as two
 /// directed edges, plus a self-loop per node (so about `2·undirected_edges/num_nodes` neighbours
-/// per node), sorted by destination. Node and edge features are uniform in [-1, 1].
+/// per node), sorted by destination, in four regions. Node and edge features are uniform in
+/// [-1, 1].
 pub fn random_graph(
     num_nodes: usize,
     undirected_edges: usize,
@@ -32,6 +33,8 @@ pub fn random_graph(
         dst_offsets[v + 1] += dst_offsets[v];
     }
     let num_edges = pairs.len();
+    // Four regions of consecutive nodes (one per node in a graph of fewer).
+    let regions = num_nodes.min(4);
     let mut uniform = |n: usize| (0..n).map(|_| rng.random_range(-1.0f32..1.0)).collect::<Vec<_>>();
     GraphBatch {
         num_nodes,
@@ -45,5 +48,7 @@ pub fn random_graph(
         dst_offsets,
         graph_of_node: vec![0; num_nodes],
         node_offsets: vec![0, num_nodes as u32],
+        region_of_node: (0..num_nodes).map(|v| (v * regions / num_nodes) as u32).collect(),
+        num_regions: regions,
     }
 }

@@ -12,8 +12,10 @@ fn small_config() -> MpnConfig {
     MpnConfig::small(8, 3)
 }
 
-fn with_context(mut config: MpnConfig) -> MpnConfig {
+/// With the graph and the region context.
+fn with_contexts(mut config: MpnConfig) -> MpnConfig {
     config.network.graph_context = true;
+    config.network.region_context = true;
     config
 }
 
@@ -35,6 +37,8 @@ fn concat(a: &GraphBatch, b: &GraphBatch, one_graph: bool) -> GraphBatch {
     let second = if one_graph { 0 } else { 1 };
     joined.graph_of_node.extend(std::iter::repeat_n(second, b.num_nodes));
     joined.node_offsets = if one_graph { vec![0, n as u32] } else { vec![0, a.num_nodes as u32, n as u32] };
+    joined.region_of_node.extend(shift(&b.region_of_node, a.num_regions));
+    joined.num_regions += b.num_regions;
     joined
 }
 
@@ -70,7 +74,7 @@ fn initialisation_is_seeded() {
 
 #[test]
 fn fused_forward_and_gradients_match_stock_candle() {
-    for config in [small_config(), with_context(small_config())] {
+    for config in [small_config(), with_contexts(small_config())] {
         fused_matches_stock_candle(config);
     }
 }
@@ -99,7 +103,7 @@ fn fused_matches_stock_candle(config: MpnConfig) {
 
 #[test]
 fn every_parameter_gets_a_gradient() {
-    let (model, varmap) = Mpn::init(with_context(small_config()), 0, DType::F32, &Device::Cpu).unwrap();
+    let (model, varmap) = Mpn::init(with_contexts(small_config()), 0, DType::F32, &Device::Cpu).unwrap();
     let mut rng = StdRng::seed_from_u64(0);
     let loss = model.forward_train(&graph(DType::F32, 2), &mut rng).unwrap().sum_all().unwrap();
     let grads = loss.backward().unwrap();
@@ -124,7 +128,7 @@ fn graph_context_reaches_across_its_graph_and_no_further() {
         predict(model, &concat(&a, b, one_graph))[..a.num_nodes].to_vec()
     };
     let (plain, _) = Mpn::init(small_config(), 1, DType::F64, &Device::Cpu).unwrap();
-    let (context, _) = Mpn::init(with_context(small_config()), 1, DType::F64, &Device::Cpu).unwrap();
+    let (context, _) = Mpn::init(with_contexts(small_config()), 1, DType::F64, &Device::Cpu).unwrap();
     // Without a context, a component the edges do not reach changes nothing.
     assert_eq!(first_graph(&plain, &b, true), first_graph(&plain, &b_changed, true));
     // With it, the other component of the same graph does; another graph of the batch does not.
@@ -134,6 +138,26 @@ fn graph_context_reaches_across_its_graph_and_no_further() {
     let alone = predict(&context, &a);
     for (x, y) in alone.iter().zip(first_graph(&context, &b, false)) {
         assert!((x - y).abs() < 1e-12, "{x} alone vs {y} in a batch");
+    }
+}
+
+/// Graphs without edges but self-loops: a node hears of another only through a context.
+#[test]
+fn region_context_reaches_across_its_region_and_no_further() {
+    let batch = random_graph(40, 0, 4, 1, 3);
+    assert_eq!(batch.region_of_node[10..20], [1; 10], "nodes 10..20 are region 1");
+    let mut changed = batch.clone();
+    changed.node_features[15 * 4..16 * 4].iter_mut().for_each(|f| *f = -*f);
+    let mut config = small_config();
+    config.network.region_context = true;
+    let (model, _) = Mpn::init(config, 1, DType::F64, &Device::Cpu).unwrap();
+    let predict = |batch: &GraphBatch| {
+        values(&model.forward(&GraphInput::from_batch(batch, DType::F64, &Device::Cpu).unwrap()).unwrap())
+    };
+    let (before, after) = (predict(&batch), predict(&changed));
+    for v in (0..40).filter(|&v| v != 15) {
+        let heard = (before[v] - after[v]).abs() > 1e-9;
+        assert_eq!(heard, (10..20).contains(&v), "node {v}: {} vs {}", before[v], after[v]);
     }
 }
 
@@ -189,7 +213,7 @@ fn checkpoints_round_trip_and_reject_wrong_shapes() {
     let dir = std::env::temp_dir().join(format!("amber-mpn-ckpt-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("model.safetensors");
-    let (model, varmap) = Mpn::init(small_config(), 5, DType::F32, &Device::Cpu).unwrap();
+    let (model, varmap) = Mpn::init(with_contexts(small_config()), 5, DType::F32, &Device::Cpu).unwrap();
     model.save(&varmap, &path).unwrap();
     let g = graph(DType::F32, 6);
     let expected = values(&model.forward(&g).unwrap());
@@ -204,8 +228,8 @@ fn checkpoints_round_trip_and_reject_wrong_shapes() {
     assert_eq!(values(&trainable.forward(&g).unwrap()), expected);
     assert_eq!(vars.all_vars().len(), model.parameters().len());
 
-    // The same weights under a configuration with another width or depth.
-    for config in [MpnConfig::small(16, 3), MpnConfig::small(8, 2)] {
+    // The same weights under a configuration with another width or depth, or without contexts.
+    for config in [with_contexts(MpnConfig::small(16, 3)), with_contexts(MpnConfig::small(8, 2)), small_config()] {
         std::fs::write(path.with_extension("json"), serde_json::to_string(&config).unwrap()).unwrap();
         assert!(matches!(Mpn::load(&path), Err(MpnError::Checkpoint { .. })));
         assert!(matches!(Mpn::load_trainable(&path, &Device::Cpu), Err(MpnError::Checkpoint { .. })));
