@@ -11,6 +11,7 @@ mod bench_mesher3d;
 mod bench_metrics;
 mod bench_mpn;
 mod dataset;
+mod fit_budget;
 mod label_rollouts;
 mod peer;
 mod plan;
@@ -47,6 +48,9 @@ enum Command {
     Ablate(reproduce::AblateArgs),
     /// Copy a reproduction's trained model into models/NAME with its card.
     ShipModel(ship_model::Args),
+    /// The AMBER steps that keep an experiment's quick budget on this machine, from the
+    /// network's measured speed against the reference machine's: a `--config` file.
+    FitBudget(fit_budget::Args),
 }
 
 #[derive(Subcommand)]
@@ -108,5 +112,6 @@ fn main() -> anyhow::Result<()> {
         Command::LabelRollouts(args) => label_rollouts::run(args),
         Command::Reproduce(args) => reproduce::run(args),
         Command::Ablate(args) => reproduce::ablate(args),
+        Command::FitBudget(args) => fit_budget::run(args),
     }
 }
