@@ -52,8 +52,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Experiment::Poisson => Task::Poisson,
         Experiment::Console => Task::Console,
     };
-    let profile_steps = amber_config(task, args.profile).steps;
-    let latent = amber_config(task, args.profile).network.latent_dim;
+    let config = amber_config(task, args.profile);
+    let (profile_steps, latent) = (config.steps, config.network.latent_dim);
     let Some(&(_, reference)) = REFERENCE_SPEEDS.iter().find(|(d, _)| *d == latent) else {
         bail!("no reference speed for latent width {latent}: fit-budget knows {REFERENCE_SPEEDS:?}");
     };

@@ -93,6 +93,7 @@ pub fn has_test_split(data: &Path) -> bool {
 #[cfg(test)]
 mod tests {
     use amber_graph::Aggregation;
+    use amber_stdx::{median, quantile};
 
     use super::*;
     use crate::folder::{DatasetSettings, problems, read_experts};
@@ -140,18 +141,12 @@ mod tests {
         let part = problems::<3, SolidPart>(vec![expert], INITIAL_SIZE, &DatasetSettings::default()).unwrap().remove(0);
         let columns = part.domain.columns(part.expert_mesh()).unwrap();
         let radius = &columns.iter().find(|c| c.name == "log_curvature_radius").unwrap().values;
-        let median = |mut v: Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        };
         let sizes = part.expert_mesh().sizes();
-        let cut = {
-            let mut sorted = sizes.clone();
-            sorted.sort_by(f64::total_cmp);
-            sorted[sorted.len() / 20]
-        };
-        let finest = median((0..sizes.len()).filter(|&e| sizes[e] <= cut).map(|e| radius[e]).collect());
-        let all = median(radius.clone());
+        let mut sorted = sizes.clone();
+        sorted.sort_by(f64::total_cmp);
+        let cut = quantile(&sorted, 0.05);
+        let finest: Vec<f64> = (0..sizes.len()).filter(|&e| sizes[e] <= cut).map(|e| radius[e]).collect();
+        let (finest, all) = (median(&finest), median(radius));
         let cap = radius.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         assert_eq!(all, cap, "flat at the median element");
         assert!(finest < all - 5f64.ln(), "log radius {finest} at the finest elements, {all} at the median");
