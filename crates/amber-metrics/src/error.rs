@@ -11,7 +11,10 @@ pub enum MetricsError {
     /// A point has a NaN or infinite coordinate.
     #[error("point {index} of the {which} point set has a non-finite coordinate")]
     NonFinitePoint { which: &'static str, index: usize },
-    /// The k-d tree could not index the points (more than `u32::MAX` of them).
+    /// A point set has more points than a `u32` index reaches.
+    #[error("the {which} point set has {len} points, more than {} can be indexed", u32::MAX)]
+    TooManyPoints { which: &'static str, len: usize },
+    /// The k-d tree could not index the points.
     #[error("cannot index the {which} point set: {source}")]
     KdTree { which: &'static str, source: kiddo::kd_tree::ConstructionError },
     /// The normalised DCD divides by d(M⁰) − d(M̂), which is zero or not finite here.
