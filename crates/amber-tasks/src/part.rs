@@ -268,18 +268,36 @@ pub struct PlanarPart {
     pub initial_mesh: Mesh2,
     /// The part's own inputs (none unless given).
     pub inputs: PartInputs<2>,
-    distance: PolygonDistance,
-    /// The diagonal of the domain's bounding box.
-    extent: f64,
+    geometry: PlanarGeometry,
 }
 
 impl PlanarPart {
     /// Meshes M⁰ uniformly with size `initial_size`.
     pub fn new(name: String, domain: PolygonDomain, initial_size: f64) -> Result<Self, MeshgenError> {
         let initial_mesh = uniform_mesh_2d(&domain, initial_size, &Mesh2dParams::default())?;
-        let distance = PolygonDistance::new(&domain);
-        let extent = diagonal(domain.bounding_box());
-        Ok(Self { name, domain, initial_mesh, inputs: PartInputs::default(), distance, extent })
+        let geometry = PlanarGeometry::new(&domain);
+        Ok(Self { name, domain, initial_mesh, inputs: PartInputs::default(), geometry })
+    }
+}
+
+/// What the [`GEOMETRY_INPUTS`] of a polygon with holes are measured with: a planar part's, and
+/// the Poisson task's, whose domains are polygons too.
+#[derive(Clone, Debug)]
+pub(crate) struct PlanarGeometry {
+    distance: PolygonDistance,
+    /// The diagonal of the domain's bounding box.
+    extent: f64,
+}
+
+impl PlanarGeometry {
+    pub(crate) fn new(domain: &PolygonDomain) -> Self {
+        Self { distance: PolygonDistance::new(domain), extent: diagonal(domain.bounding_box()) }
+    }
+
+    /// The [`GEOMETRY_INPUTS`] of elements with midpoints `midpoints`.
+    pub(crate) fn columns(&self, midpoints: &[[f64; 2]]) -> Vec<Column> {
+        let distance = &self.distance;
+        geometry_columns(midpoints, self.extent, |p| distance.to_boundary(p), |p| distance.to_corner(p))
     }
 }
 
@@ -300,9 +318,9 @@ impl Domain<2> for PlanarPart {
     /// The [`GEOMETRY_INPUTS`] and the part's inputs; the feature set's own features are
     /// computed by the graph.
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-        let (midpoints, distance, extent) = (mesh.midpoints(), &self.distance, self.extent);
-        let mut columns = geometry_columns(&midpoints, extent, |p| distance.to_boundary(p), |p| distance.to_corner(p));
-        columns.extend(self.inputs.columns(&midpoints, extent));
+        let midpoints = mesh.midpoints();
+        let mut columns = self.geometry.columns(&midpoints);
+        columns.extend(self.inputs.columns(&midpoints, self.geometry.extent));
         Ok(columns)
     }
 
@@ -329,7 +347,7 @@ mod tests {
         assert_eq!(names, GEOMETRY_INPUTS);
         let [boundary, feature, turn, radius] = [0, 1, 2, 3].map(|i| &columns[i].values);
         // The L-shape's sides are straight: its curvature radius is the cap everywhere.
-        assert!(radius.iter().all(|&r| (r - part.extent.ln()).abs() < 1e-12));
+        assert!(radius.iter().all(|&r| (r - part.geometry.extent.ln()).abs() < 1e-12));
         assert!(boundary.iter().all(|v| v.is_finite()) && boundary.len() == part.initial_mesh.num_elements());
         assert!(boundary.iter().zip(feature).all(|(b, f)| b <= f));
         let distance_to_reentrant = |e: usize| {

@@ -9,6 +9,7 @@ use amber_mesh::{Mesh, Mesh2};
 use amber_meshgen::{Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, generate_2d, uniform_mesh_2d};
 
 use super::{INITIAL_SIZE, PoissonProblem};
+use crate::part::{GEOMETRY_INPUTS, PlanarGeometry};
 use crate::problem::{Column, Domain, Problem, ProblemError};
 
 /// Name of the optional input ln η_K: the residual error indicator of the current solution, the
@@ -21,8 +22,16 @@ pub const LOG_ERROR_INDICATOR_COLUMN: &str = "log_error_indicator";
 /// yet the expert refines well into the flanks. Not in the paper.
 pub const LOG_LOAD_COLUMN: &str = "log_load";
 
-/// The optional inputs of the Poisson task.
-const OPTIONAL_INPUTS: &[&str] = &[LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN];
+/// The optional inputs of the Poisson task: its own, and the geometry's that every polygon has
+/// (the distance to the re-entrant corner and the boundary's turn there among them).
+const OPTIONAL_INPUTS: [&str; 2 + GEOMETRY_INPUTS.len()] = [
+    LOG_ERROR_INDICATOR_COLUMN,
+    LOG_LOAD_COLUMN,
+    GEOMETRY_INPUTS[0],
+    GEOMETRY_INPUTS[1],
+    GEOMETRY_INPUTS[2],
+    GEOMETRY_INPUTS[3],
+];
 
 impl PoissonProblem {
     /// The quadrature order of the expert's solver (the default heuristic's when unknown).
@@ -45,7 +54,7 @@ impl Domain<2> for PoissonProblem {
     }
 
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-        poisson_columns(&self.load, self.quadrature_order(), mesh)
+        poisson_columns(&PolygonDomain::lshape(self.corner)?, &self.load, self.quadrature_order(), mesh)
     }
 
     fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
@@ -106,7 +115,7 @@ impl Domain<2> for PoissonPart {
     }
 
     fn columns(&self, mesh: &Mesh<2>) -> Result<Vec<Column>, ProblemError> {
-        poisson_columns(&self.load, self.quadrature_order, mesh)
+        poisson_columns(&self.domain, &self.load, self.quadrature_order, mesh)
     }
 
     fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
@@ -114,10 +123,15 @@ impl Domain<2> for PoissonPart {
     }
 }
 
-/// Solves −Δu = f (P1) on `mesh`: `solution_mean`, `solution_std` of u over each element's
-/// vertices, `load` = f at the element midpoint, and the optional inputs ln η_K and the
-/// log-scaled load.
-fn poisson_columns(load: &GaussianMixture, quadrature_order: usize, mesh: &Mesh2) -> Result<Vec<Column>, ProblemError> {
+/// Solves −Δu = f (P1) on `mesh`, a mesh of `domain`: `solution_mean`, `solution_std` of u over
+/// each element's vertices, `load` = f at the element midpoint, and the optional inputs ln η_K,
+/// the log-scaled load and the geometry's.
+fn poisson_columns(
+    domain: &PolygonDomain,
+    load: &GaussianMixture,
+    quadrature_order: usize,
+    mesh: &Mesh2,
+) -> Result<Vec<Column>, ProblemError> {
     let space = P1Space::new(mesh)?;
     let quadrature = Quadrature::simplex::<2>(quadrature_order)?;
     let samples = space.sample_load(load, &quadrature)?;
@@ -126,7 +140,8 @@ fn poisson_columns(load: &GaussianMixture, quadrature_order: usize, mesh: &Mesh2
     let indicator = space.residual_estimator(&solution.u, &samples)?;
     let values: Vec<f64> = mesh.midpoints().into_iter().map(|x| Load::value(load, x)).collect();
     let log_load = values.iter().map(|f| f.signum() * f.abs().ln_1p()).collect();
-    Ok(vec![
+    let geometry = PlanarGeometry::new(domain).columns(&mesh.midpoints());
+    let mut columns = vec![
         Column { name: "solution_mean".into(), values: stats.iter().map(|s| s.mean).collect() },
         Column { name: "solution_std".into(), values: stats.iter().map(|s| s.std).collect() },
         Column { name: "load".into(), values },
@@ -135,7 +150,9 @@ fn poisson_columns(load: &GaussianMixture, quadrature_order: usize, mesh: &Mesh2
             values: indicator.iter().map(|eta| eta.max(f64::MIN_POSITIVE).ln()).collect(),
         },
         Column { name: LOG_LOAD_COLUMN.into(), values: log_load },
-    ])
+    ];
+    columns.extend(geometry);
+    Ok(columns)
 }
 
 /// A new mesh of `domain` from the piecewise-constant field `sizes` on `mesh`.
@@ -147,4 +164,35 @@ fn remesh_polygon(
 ) -> Result<Mesh2, ProblemError> {
     let params = Mesh2dParams::default().with_max_elements(max_elements);
     Ok(generate_2d(domain, &MeshSizing::new(mesh, sizes), &params)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::FRAC_PI_2;
+
+    use super::*;
+    use crate::poisson::ProblemSample;
+
+    /// A Poisson part offers every column it names, one value per element, and its geometry
+    /// columns see the L-shape's re-entrant corner: where the expert's refinement starts.
+    #[test]
+    fn poisson_columns_include_the_geometry_inputs() {
+        let sample = ProblemSample::draw(3).unwrap();
+        let part = PoissonPart::new(PolygonDomain::lshape(sample.corner).unwrap(), sample.load, None, 2).unwrap();
+        let mesh = part.initial_mesh();
+        let columns = part.columns(mesh).unwrap();
+        for name in part.optional_inputs() {
+            let column = columns.iter().find(|c| c.name == name).unwrap_or_else(|| panic!("no column {name}"));
+            assert_eq!(column.values.len(), mesh.num_elements());
+            assert!(column.values.iter().all(|v| v.is_finite()), "{name}");
+        }
+        let values = |name: &str| &columns.iter().find(|c| c.name == name).unwrap().values;
+        let to_corner = |e: usize| {
+            let [x, y] = mesh.midpoint(e);
+            (x - sample.corner[0]).hypot(y - sample.corner[1])
+        };
+        let nearest = (0..mesh.num_elements()).min_by(|&a, &b| to_corner(a).total_cmp(&to_corner(b))).unwrap();
+        assert!((values("feature_turn")[nearest] + FRAC_PI_2).abs() < 1e-12);
+        assert!((values("log_feature_distance")[nearest] - to_corner(nearest).ln()).abs() < 1e-12);
+    }
 }
