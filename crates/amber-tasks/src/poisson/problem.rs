@@ -24,14 +24,13 @@ pub const LOG_LOAD_COLUMN: &str = "log_load";
 
 /// The optional inputs of the Poisson task: its own, and the geometry's that every polygon has
 /// (the distance to the re-entrant corner and the boundary's turn there among them).
-const OPTIONAL_INPUTS: [&str; 2 + GEOMETRY_INPUTS.len()] = [
-    LOG_ERROR_INDICATOR_COLUMN,
-    LOG_LOAD_COLUMN,
-    GEOMETRY_INPUTS[0],
-    GEOMETRY_INPUTS[1],
-    GEOMETRY_INPUTS[2],
-    GEOMETRY_INPUTS[3],
-];
+fn optional_inputs() -> Vec<String> {
+    [LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN]
+        .iter()
+        .chain(&GEOMETRY_INPUTS)
+        .map(|name| (*name).to_owned())
+        .collect()
+}
 
 impl PoissonProblem {
     /// The quadrature order of the expert's solver (the default heuristic's when unknown).
@@ -46,7 +45,7 @@ impl Domain<2> for PoissonProblem {
     }
 
     fn optional_inputs(&self) -> Vec<String> {
-        OPTIONAL_INPUTS.iter().map(|name| (*name).to_owned()).collect()
+        optional_inputs()
     }
 
     fn initial_mesh(&self) -> &Mesh<2> {
@@ -107,7 +106,7 @@ impl Domain<2> for PoissonPart {
     }
 
     fn optional_inputs(&self) -> Vec<String> {
-        OPTIONAL_INPUTS.iter().map(|name| (*name).to_owned()).collect()
+        optional_inputs()
     }
 
     fn initial_mesh(&self) -> &Mesh<2> {
@@ -138,9 +137,10 @@ fn poisson_columns(
     let solution = space.solve_poisson(&samples)?;
     let stats = element_stats(mesh, &solution.u)?;
     let indicator = space.residual_estimator(&solution.u, &samples)?;
-    let values: Vec<f64> = mesh.midpoints().into_iter().map(|x| Load::value(load, x)).collect();
+    let midpoints = mesh.midpoints();
+    let values: Vec<f64> = midpoints.iter().map(|&x| Load::value(load, x)).collect();
     let log_load = values.iter().map(|f| f.signum() * f.abs().ln_1p()).collect();
-    let geometry = PlanarGeometry::new(domain).columns(&mesh.midpoints());
+    let geometry = PlanarGeometry::new(domain).columns(&midpoints);
     let mut columns = vec![
         Column { name: "solution_mean".into(), values: stats.iter().map(|s| s.mean).collect() },
         Column { name: "solution_std".into(), values: stats.iter().map(|s| s.std).collect() },
