@@ -1,6 +1,6 @@
 //! Projection of an expert mesh's sizing field onto another mesh: the training labels (spec §3).
 
-use amber_mesh::{Mesh, PointLocator};
+use amber_mesh::{Mesh, PointLocator, size_from_volume};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -14,6 +14,13 @@ pub enum Aggregation {
     Mean,
     /// Maximum over the expert elements (AMBER-Max).
     Max,
+    /// The size at which the element would hold as many elements as the expert has there: the
+    /// regular simplex of volume |K| / n for n assigned expert elements, kept within their
+    /// smallest and largest size. Of a coarse element in a graded region, Max asks for fewer
+    /// elements than the expert has in it (a mesh can stay at such a fixed point, coarser than
+    /// the expert's) and Mean, dominated by the many small ones, for more; this label asks for
+    /// as many.
+    Density,
 }
 
 /// The expert sizing field as one label per element of `current`.
@@ -41,22 +48,29 @@ pub fn project_expert_sizing<const D: usize>(
         expert.midpoints().par_iter().with_min_len(256).map(|&c| locator.locate_or_nearest(c).element()).collect();
 
     let n = current.num_elements();
-    let mut labels = vec![0.0; n];
+    let mut sums = vec![0.0; n];
+    let mut smallest = vec![f64::INFINITY; n];
+    let mut largest = vec![0.0f64; n];
     let mut counts = vec![0u32; n];
     for (&owner, &h) in owners.iter().zip(&expert_sizes) {
-        labels[owner] = match aggregation {
-            Aggregation::Mean => labels[owner] + h,
-            Aggregation::Max => f64::max(labels[owner], h),
-        };
+        sums[owner] += h;
+        smallest[owner] = smallest[owner].min(h);
+        largest[owner] = largest[owner].max(h);
         counts[owner] += 1;
     }
-    if aggregation == Aggregation::Mean {
-        for (label, &count) in labels.iter_mut().zip(&counts) {
-            if count > 0 {
-                *label /= f64::from(count);
+    let mut labels: Vec<f64> = (0..n)
+        .map(|i| {
+            let count = f64::from(counts[i]);
+            if counts[i] == 0 {
+                return 0.0; // filled below
             }
-        }
-    }
+            match aggregation {
+                Aggregation::Mean => sums[i] / count,
+                Aggregation::Max => largest[i],
+                Aggregation::Density => size_from_volume::<D>(current.volume(i) / count).clamp(smallest[i], largest[i]),
+            }
+        })
+        .collect();
 
     let unassigned: Vec<usize> = (0..n).filter(|&i| counts[i] == 0).collect();
     if !unassigned.is_empty() {
@@ -126,6 +140,30 @@ mod tests {
         assert!((mean[0] - 0.5 * (sizes[0] + sizes[1])).abs() < 1e-15);
         assert_eq!(max[0], sizes[0].max(sizes[1]));
         assert!((mean[1] - size(0.25)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn density_labels_keep_the_expert_element_count() {
+        // The lower-right triangle (area 0.5) holds the expert's two elements of areas 0.375 and
+        // 0.125: two elements of 0.25 each, the regular size of area 0.25. The max asks for
+        // larger elements, the mean (dominated by the small one) for smaller.
+        let expert = Mesh2::new(
+            vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.75, 0.0]],
+            vec![0, 4, 2, 4, 1, 2, 0, 2, 3],
+        )
+        .unwrap();
+        let density = project_expert_sizing(&square(), &expert, Aggregation::Density).unwrap();
+        let mean = project_expert_sizing(&square(), &expert, Aggregation::Mean).unwrap();
+        let max = project_expert_sizing(&square(), &expert, Aggregation::Max).unwrap();
+        assert!((density[0] - size(0.25)).abs() < 1e-15);
+        assert!(mean[0] < density[0] && density[0] < max[0]);
+        // One expert element per current element: its own size, as for the other aggregations.
+        assert!((density[1] - size(0.5)).abs() < 1e-15);
+        // A current element smaller than the one expert element assigned to it takes the
+        // expert's size, not its own.
+        let fine = fan([0.3, 0.3]);
+        let labels = project_expert_sizing(&fine, &uneven_expert(), Aggregation::Density).unwrap();
+        assert_eq!(labels, project_expert_sizing(&fine, &uneven_expert(), Aggregation::Max).unwrap());
     }
 
     #[test]
