@@ -35,12 +35,17 @@ pub enum Objective {
     /// The later version (§11.3): size = softplus(z + softplus⁻¹(h)), h the element's current
     /// size; MSE of z against the residual softplus⁻¹(y) − softplus⁻¹(h). Needs a current mesh.
     SoftplusResidual,
+    /// size = h·exp(z), h the element's current size; MSE of z against ln(y/h). The residual
+    /// in log space: unlike the softplus residual, which is logarithmic only for sizes well
+    /// below 1 (Poisson's unit square) and nearly linear for sizes of several units (Console's
+    /// millimetres), it weighs a size's relative error alike at every scale and in every unit.
+    LogResidual,
 }
 
 impl Objective {
     /// Whether [`Self::target`] and [`Self::size`] read the element's current size.
     pub fn needs_current_size(self) -> bool {
-        self == Objective::SoftplusResidual
+        matches!(self, Objective::SoftplusResidual | Objective::LogResidual)
     }
 
     /// Whether the loss compares the output itself with the targets, so that the targets may
@@ -60,6 +65,7 @@ impl Objective {
             Objective::LogMse => y.ln(),
             Objective::SoftplusMse | Objective::Mse => y,
             Objective::SoftplusResidual => softplus_inverse(y) - softplus_inverse(residual_base(current)),
+            Objective::LogResidual => (y / residual_base(current)).ln(),
         }
     }
 
@@ -71,6 +77,7 @@ impl Objective {
             Objective::SoftplusMse => softplus(z),
             Objective::Mse => z,
             Objective::SoftplusResidual => softplus(z + softplus_inverse(residual_base(current))),
+            Objective::LogResidual => residual_base(current) * z.exp(),
         }
     }
 
@@ -81,13 +88,13 @@ impl Objective {
         match self {
             // relu(z) + log(1 + exp(-|z|)): exact and overflow-free for any z.
             Objective::SoftplusMse => z.relu()? + (z.abs()?.neg()?.exp()? + 1.0)?.log()?,
-            Objective::LogMse | Objective::Mse | Objective::SoftplusResidual => Ok(z.clone()),
+            Objective::LogMse | Objective::Mse | Objective::SoftplusResidual | Objective::LogResidual => Ok(z.clone()),
         }
     }
 }
 
 fn residual_base(current: Option<f64>) -> f64 {
-    current.expect("softplus_residual needs the element's current size")
+    current.expect("a residual objective needs the element's current size")
 }
 
 #[cfg(test)]
@@ -96,8 +103,13 @@ mod tests {
 
     use super::*;
 
-    const ALL: [Objective; 4] =
-        [Objective::LogMse, Objective::SoftplusMse, Objective::Mse, Objective::SoftplusResidual];
+    const ALL: [Objective; 5] = [
+        Objective::LogMse,
+        Objective::SoftplusMse,
+        Objective::Mse,
+        Objective::SoftplusResidual,
+        Objective::LogResidual,
+    ];
 
     #[test]
     fn softplus_inverse_inverts_softplus_over_the_size_range() {
@@ -116,6 +128,16 @@ mod tests {
                 assert!((objective.size(z, Some(h)) - y).abs() < 1e-12 * y.max(1.0), "{objective:?}: {y}");
             }
         }
+    }
+
+    #[test]
+    fn the_log_residual_does_not_depend_on_the_unit() {
+        // The same refinement, 4.4 → 0.4, in millimetres and in metres: one target.
+        let target = |scale: f64| Objective::LogResidual.target(0.4 * scale, Some(4.4 * scale));
+        assert!((target(1.0) - target(1e-3)).abs() < 1e-12);
+        // The softplus residual's target differs by a factor of about 2 between the two units.
+        let softplus = |scale: f64| Objective::SoftplusResidual.target(0.4 * scale, Some(4.4 * scale));
+        assert!(softplus(1.0) / softplus(1e-3) > 1.5);
     }
 
     #[test]

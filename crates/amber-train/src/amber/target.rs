@@ -64,7 +64,13 @@ mod tests {
     fn perfect_outputs_map_back_to_the_labels() {
         let labels = [0.01, 0.2, 0.5];
         let current = [0.9, 0.1, 0.5];
-        for objective in [Objective::SoftplusMse, Objective::Mse, Objective::LogMse, Objective::SoftplusResidual] {
+        for objective in [
+            Objective::SoftplusMse,
+            Objective::Mse,
+            Objective::LogMse,
+            Objective::SoftplusResidual,
+            Objective::LogResidual,
+        ] {
             let mut t = TargetTransform::new(objective, true);
             let raw = t.raw_targets(&labels, &current);
             t.update(&raw);
