@@ -60,10 +60,10 @@ pub fn project_expert_sizing<const D: usize>(
     }
     let mut labels: Vec<f64> = (0..n)
         .map(|i| {
-            let count = f64::from(counts[i]);
             if counts[i] == 0 {
                 return 0.0; // filled below
             }
+            let count = f64::from(counts[i]);
             match aggregation {
                 Aggregation::Mean => sums[i] / count,
                 Aggregation::Max => largest[i],
