@@ -7,6 +7,7 @@
 mod domain;
 mod error;
 mod mesh2d;
+mod predicates;
 mod quality;
 mod sizing;
 

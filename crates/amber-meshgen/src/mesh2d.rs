@@ -7,8 +7,12 @@
 //!    outside the domain splits that segment at its midpoint instead (Ruppert).
 //! 3. Quality-guarded Laplacian smoothing of interior vertices (a move is kept only if the
 //!    smallest angle of the vertex's star does not drop).
-//! 4. A final constrained Delaunay re-triangulation of the smoothed vertices.
+//! 4. Edge flips restore the constrained Delaunay property the smoothing broke (Lawson): the
+//!    smoothed mesh is still a valid triangulation of the domain, so flipping every edge whose
+//!    opposite vertex lies in the other triangle's circumcircle ends at the constrained
+//!    Delaunay triangulation of the smoothed vertices, without triangulating them anew.
 
+use std::cmp::Ordering;
 use std::collections::VecDeque;
 
 use amber_mesh::Mesh2;
@@ -18,6 +22,7 @@ use spade::{
     Triangulation,
 };
 
+use crate::predicates::incircle;
 use crate::{ConstantSize, MeshgenError, PolygonDomain, SizingField};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
@@ -81,14 +86,14 @@ pub fn generate_2d<F: SizingField<2> + ?Sized>(
     let (points, segments) = discretise_boundary(domain, &size, params.max_elements)?;
     let mut cdt = bulk_load(points, segments)?;
     let side = refine(&mut cdt, &size, params)?;
-    let (vertices, triangles, segments) = export(&cdt, &side);
-    // Spatially coherent numbering: smoothing, the final triangulation and every consumer of
-    // the mesh (FEM assembly, graphs) touch neighbours that are near in memory.
-    let (mut vertices, triangles, segments) = morton_order(vertices, triangles, segments);
+    let Exported { vertices, mut triangles, mut neighbours, segments } = export(&cdt, &side);
+    drop(cdt);
+    // Spatially coherent numbering: smoothing, the flips and every consumer of the mesh (FEM
+    // assembly, graphs) touch neighbours that are near in memory.
+    let (mut vertices, segments) = morton_order(vertices, &mut triangles, segments);
     smooth(&mut vertices, &triangles, &segments, params.smoothing_passes);
-    let cdt = bulk_load(vertices.clone(), segments)?;
-    let (_, triangles, _) = export(&cdt, &classify_faces(&cdt));
-    Ok(Mesh2::new(vertices, triangles)?)
+    restore_delaunay(&vertices, &mut triangles, &mut neighbours);
+    Ok(Mesh2::new(vertices, triangles_in_vertex_order(triangles))?)
 }
 
 /// A mesh of `domain` with uniform target size `size` (e.g. the initial mesh M⁰, spec §1).
@@ -332,30 +337,67 @@ fn circumcircle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> ([f64; 2], f64) {
     ([a[0] + ux, a[1] + uy], ux * ux + uy * uy)
 }
 
-/// Vertices (in spade's order), the inside triangles (counter-clockwise), and the boundary
-/// segments.
-fn export(cdt: &Cdt, side: &[u8]) -> (Vec<[f64; 2]>, Vec<u32>, Vec<[usize; 2]>) {
-    let vertices = cdt.vertices().map(|v| [v.position().x, v.position().y]).collect();
-    let mut triangles = Vec::with_capacity(3 * cdt.num_inner_faces());
-    for face in cdt.inner_faces() {
-        if side[face.fix().index()] == INSIDE {
-            triangles.extend(face.vertices().map(|v| v.fix().index() as u32));
-        }
-    }
-    let segments = cdt
-        .undirected_edges()
-        .filter(|e| e.is_constraint_edge())
-        .map(|e| e.vertices().map(|v| v.fix().index()))
-        .collect();
-    (vertices, triangles, segments)
+/// Across a boundary segment: no triangle, and no flip.
+const NO_NEIGHBOUR: u32 = u32::MAX;
+
+/// The inside of a triangulation as flat arrays.
+struct Exported {
+    /// In spade's order.
+    vertices: Vec<[f64; 2]>,
+    /// Counter-clockwise, three vertex indices each.
+    triangles: Vec<u32>,
+    /// Per triangle corner k, the triangle across the edge opposite k, or `NO_NEIGHBOUR` across
+    /// a boundary segment.
+    neighbours: Vec<u32>,
+    /// The boundary segments.
+    segments: Vec<[usize; 2]>,
 }
 
-/// Renumbers vertices along a Morton (Z-order) curve.
+fn export(cdt: &Cdt, side: &[u8]) -> Exported {
+    let ((vertices, segments), (triangles, neighbours)) = rayon::join(
+        || {
+            let vertices = cdt.vertices().map(|v| [v.position().x, v.position().y]).collect();
+            let segments = cdt
+                .undirected_edges()
+                .filter(|e| e.is_constraint_edge())
+                .map(|e| e.vertices().map(|v| v.fix().index()))
+                .collect();
+            (vertices, segments)
+        },
+        || inside_triangles(cdt, side),
+    );
+    Exported { vertices, triangles, neighbours, segments }
+}
+
+/// The inside triangles and their neighbours, numbered in face order.
+fn inside_triangles(cdt: &Cdt, side: &[u8]) -> (Vec<u32>, Vec<u32>) {
+    let mut inside = 0;
+    let triangle_of_face: Vec<u32> = side
+        .iter()
+        .map(|&s| {
+            inside += u32::from(s == INSIDE);
+            if s == INSIDE { inside - 1 } else { NO_NEIGHBOUR }
+        })
+        .collect();
+    let mut triangles = Vec::with_capacity(3 * inside as usize);
+    let mut neighbours = Vec::with_capacity(3 * inside as usize);
+    for face in cdt.inner_faces().filter(|f| side[f.fix().index()] == INSIDE) {
+        // Edge i runs from corner i to corner i + 1, opposite corner i + 2.
+        let edges = face.adjacent_edges();
+        triangles.extend(edges.map(|e| e.from().fix().index() as u32));
+        neighbours.extend([edges[1], edges[2], edges[0]].map(|e| {
+            if e.is_constraint_edge() { NO_NEIGHBOUR } else { triangle_of_face[e.rev().face().fix().index()] }
+        }));
+    }
+    (triangles, neighbours)
+}
+
+/// Renumbers vertices along a Morton (Z-order) curve, in the triangles and segments too.
 fn morton_order(
     vertices: Vec<[f64; 2]>,
-    triangles: Vec<u32>,
+    triangles: &mut [u32],
     segments: Vec<[usize; 2]>,
-) -> (Vec<[f64; 2]>, Vec<u32>, Vec<[usize; 2]>) {
+) -> (Vec<[f64; 2]>, Vec<[usize; 2]>) {
     let (lo, hi) = vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), p| {
         ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])])
     });
@@ -373,15 +415,18 @@ fn morton_order(
         .enumerate()
         .map(|(i, p)| (spread((p[0] - lo[0]) * scale) | (spread((p[1] - lo[1]) * scale) << 1), i as u32))
         .collect();
-    order.sort_unstable();
+    // Stable: vertices sharing a code keep spade's order, as the sort of the pairs kept it.
+    radsort::sort_by_key(&mut order, |&(code, _)| code);
     let mut new_index = vec![0u32; vertices.len()];
     for (new, &(_, old)) in order.iter().enumerate() {
         new_index[old as usize] = new as u32;
     }
     let sorted = order.iter().map(|&(_, old)| vertices[old as usize]).collect();
-    let triangles = triangles.into_iter().map(|v| new_index[v as usize]).collect();
+    for v in triangles {
+        *v = new_index[*v as usize];
+    }
     let segments = segments.into_iter().map(|s| s.map(|v| new_index[v] as usize)).collect();
-    (sorted, triangles, segments)
+    (sorted, segments)
 }
 
 /// Quality-guarded Laplacian smoothing: each interior vertex moves to the mean of its
@@ -397,25 +442,88 @@ fn smooth(vertices: &mut [[f64; 2]], triangles: &[u32], segments: &[[usize; 2]],
         fixed[s[1]] = true;
     }
     let star = Csr::vertex_to_triangles(n, triangles);
-    let neighbours = Csr::vertex_to_neighbours(&star, triangles);
     for _ in 0..passes {
         for v in 0..n {
-            let ring = neighbours.row(v);
-            if fixed[v] || ring.is_empty() {
+            let around = star.row(v);
+            if fixed[v] || around.is_empty() {
                 continue;
             }
             let old = vertices[v];
-            let before = star_quality(vertices, triangles, star.row(v));
-            let inv = 1.0 / ring.len() as f64;
-            vertices[v] = ring.iter().fold([0.0, 0.0], |s, &w| {
-                let p = vertices[w as usize];
-                [s[0] + p[0] * inv, s[1] + p[1] * inv]
-            });
-            if star_quality(vertices, triangles, star.row(v)) < before {
+            let before = star_quality(vertices, triangles, around);
+            // Every vertex off the boundary segments is interior, so its ring of neighbours is
+            // closed: each neighbour is a corner of exactly two of its triangles.
+            let weight = 0.5 / around.len() as f64;
+            let mut mean = [0.0, 0.0];
+            for &t in around {
+                for &w in triangles[3 * t as usize..3 * t as usize + 3].iter().filter(|&&w| w as usize != v) {
+                    let p = vertices[w as usize];
+                    mean = [mean[0] + p[0] * weight, mean[1] + p[1] * weight];
+                }
+            }
+            vertices[v] = mean;
+            if star_quality(vertices, triangles, around) < before {
                 vertices[v] = old;
             }
         }
     }
+}
+
+/// Flips interior edges until every one is locally Delaunay (Lawson). Each flip turns the
+/// quadrilateral a, b, d, c of triangles t = (a, b, c) and u = (d, c, b) into (a, b, d) and
+/// (a, d, c); the exact in-circle test keeps it finite.
+fn restore_delaunay(vertices: &[[f64; 2]], triangles: &mut [u32], neighbours: &mut [u32]) {
+    let mut stack: Vec<(u32, u8)> = (0..neighbours.len())
+        .filter(|&i| neighbours[i] != NO_NEIGHBOUR && (i / 3) < neighbours[i] as usize)
+        .map(|i| ((i / 3) as u32, (i % 3) as u8))
+        .collect();
+    while let Some((t, k)) = stack.pop() {
+        let (t, k) = (t as usize, k as usize);
+        let u = neighbours[3 * t + k];
+        if u == NO_NEIGHBOUR {
+            continue;
+        }
+        let u = u as usize;
+        let corner = |tri: usize, i: usize| triangles[3 * tri + i % 3];
+        let (a, b, c) = (corner(t, k), corner(t, k + 1), corner(t, k + 2));
+        let j = (0..3).find(|&j| corner(u, j) != b && corner(u, j) != c).expect("neighbours share an edge");
+        let d = corner(u, j);
+        let at = |v: u32| vertices[v as usize];
+        if incircle(at(a), at(b), at(c), at(d)) != Ordering::Greater {
+            continue;
+        }
+        let (ab, ca) = (neighbours[3 * t + (k + 2) % 3], neighbours[3 * t + (k + 1) % 3]);
+        let (bd, dc) = (neighbours[3 * u + (j + 1) % 3], neighbours[3 * u + (j + 2) % 3]);
+        triangles[3 * t..3 * t + 3].copy_from_slice(&[a, b, d]);
+        triangles[3 * u..3 * u + 3].copy_from_slice(&[a, d, c]);
+        neighbours[3 * t..3 * t + 3].copy_from_slice(&[bd, u as u32, ab]);
+        neighbours[3 * u..3 * u + 3].copy_from_slice(&[dc, ca, t as u32]);
+        for (moved, from, to) in [(bd, u, t), (ca, t, u)] {
+            if moved != NO_NEIGHBOUR {
+                let moved = moved as usize;
+                let slot = (0..3).find(|&i| neighbours[3 * moved + i] == from as u32).expect("adjacency is symmetric");
+                neighbours[3 * moved + slot] = to as u32;
+            }
+        }
+        stack.extend([(t, 0), (t, 2), (u, 0), (u, 1)].map(|(tri, i)| (tri as u32, i as u8)));
+    }
+}
+
+/// The triangles ordered by their smallest vertex index, so that on a Morton-numbered
+/// mesh nearby triangles are near in memory.
+fn triangles_in_vertex_order(triangles: Vec<u32>) -> Vec<u32> {
+    // Keys (smallest vertex, triangle) are distinct: the sort is deterministic.
+    let mut keys: Vec<u64> = triangles
+        .chunks_exact(3)
+        .enumerate()
+        .map(|(t, c)| (u64::from(c[0].min(c[1]).min(c[2])) << 32) | t as u64)
+        .collect();
+    radsort::sort(&mut keys);
+    let mut ordered = Vec::with_capacity(triangles.len());
+    for key in keys {
+        let t = 3 * (key as u32) as usize;
+        ordered.extend_from_slice(&triangles[t..t + 3]);
+    }
+    ordered
 }
 
 /// A monotone measure of the smallest angle over the triangles of a star: sin²(min angle),
@@ -458,40 +566,9 @@ impl Csr {
         Self { offsets, items }
     }
 
-    /// For each vertex, its distinct edge neighbours, from the vertex-to-triangle rows.
-    fn vertex_to_neighbours(star: &Csr, triangles: &[u32]) -> Self {
-        let n = star.offsets.len() - 1;
-        let mut offsets = Vec::with_capacity(n + 1);
-        offsets.push(0u32);
-        let mut items = Vec::with_capacity(2 * star.items.len());
-        for v in 0..n {
-            let begin = items.len();
-            for &t in star.row(v) {
-                items.extend(triangles[3 * t as usize..3 * t as usize + 3].iter().filter(|&&w| w as usize != v));
-            }
-            items[begin..].sort_unstable();
-            let unique = dedup_in_place(&mut items[begin..]);
-            items.truncate(begin + unique);
-            offsets.push(items.len() as u32);
-        }
-        Self { offsets, items }
-    }
-
     fn row(&self, i: usize) -> &[u32] {
         &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize]
     }
-}
-
-/// Moves the distinct values of a sorted slice to its front; returns how many there are.
-fn dedup_in_place(sorted: &mut [u32]) -> usize {
-    let mut unique = 0;
-    for i in 0..sorted.len() {
-        if i == 0 || sorted[i] != sorted[unique - 1] {
-            sorted[unique] = sorted[i];
-            unique += 1;
-        }
-    }
-    unique
 }
 
 #[cfg(test)]
@@ -560,6 +637,7 @@ mod tests {
             let field = FnSize(move |x: [f64; 2]| h0 * (1.0 + wave * (5.0 * x[0]).sin() * (3.0 * x[1]).cos()));
             let mesh = generate_2d(&domain, &field, &Mesh2dParams::default()).unwrap();
             assert_valid(&mesh, &domain);
+            assert_constrained_delaunay(&mesh);
         }
 
         #[test]
@@ -574,6 +652,51 @@ mod tests {
         }
     }
 
+    /// The mesh's triangles as a set, each a sorted triple.
+    fn triangle_set(triangles: &[u32]) -> Vec<[u32; 3]> {
+        let mut set: Vec<[u32; 3]> = triangles
+            .chunks_exact(3)
+            .map(|c| {
+                let mut t = [c[0], c[1], c[2]];
+                t.sort_unstable();
+                t
+            })
+            .collect();
+        set.sort_unstable();
+        set
+    }
+
+    /// The flips end where a triangulation from scratch does: at the constrained Delaunay
+    /// triangulation (by spade) of the final vertices and boundary segments.
+    fn assert_constrained_delaunay(mesh: &Mesh2) {
+        let adjacency = FacetAdjacency::new(mesh).unwrap();
+        let segments = adjacency
+            .boundary_facets()
+            .map(|(e, local)| {
+                let cell = mesh.element(e);
+                [cell[(local + 1) % 3] as usize, cell[(local + 2) % 3] as usize]
+            })
+            .collect();
+        let cdt = bulk_load(mesh.vertices().to_vec(), segments).unwrap();
+        let delaunay = export(&cdt, &classify_faces(&cdt));
+        assert_eq!(triangle_set(mesh.cells()), triangle_set(&delaunay.triangles));
+    }
+
+    #[test]
+    fn a_flip_makes_a_quadrilateral_delaunay() {
+        // A rhombus split along its long diagonal b–c, which is not Delaunay: d lies in the
+        // circumcircle of a, b, c (the angles opposite b–c sum to 254°).
+        let vertices = [[0.0, 0.0], [1.0, -2.0], [1.0, 2.0], [2.0, 0.0]];
+        let mut triangles = vec![0, 1, 2, 3, 2, 1];
+        let mut neighbours = vec![1, NO_NEIGHBOUR, NO_NEIGHBOUR, 0, NO_NEIGHBOUR, NO_NEIGHBOUR];
+        restore_delaunay(&vertices, &mut triangles, &mut neighbours);
+        assert_eq!(triangle_set(&triangles), vec![[0, 1, 3], [0, 2, 3]]);
+        let mesh = Mesh2::new(vertices.to_vec(), triangles.clone()).expect("flipped triangles stay counter-clockwise");
+        assert_constrained_delaunay(&mesh);
+        // Both triangles still name each other across the new diagonal.
+        assert_eq!(neighbours, vec![NO_NEIGHBOUR, 1, NO_NEIGHBOUR, NO_NEIGHBOUR, NO_NEIGHBOUR, 0]);
+    }
+
     #[test]
     fn holes_are_left_empty() {
         let square = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
@@ -581,6 +704,7 @@ mod tests {
         let domain = PolygonDomain::new(square, vec![hole]).unwrap();
         let mesh = generate_2d(&domain, &ConstantSize(0.05), &Mesh2dParams::default()).unwrap();
         assert_valid(&mesh, &domain);
+        assert_constrained_delaunay(&mesh);
         assert!(mesh.midpoints().iter().all(|&m| domain.contains(m)));
     }
 

@@ -10,7 +10,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 use nalgebra::Vector3;
 use rstar::{AABB, Envelope};
 
-use super::predicates::{orient2d, orient3d};
+use crate::predicates::{orient2d, orient3d};
 
 type Triangle = [[f64; 3]; 3];
 

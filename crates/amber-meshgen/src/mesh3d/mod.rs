@@ -3,13 +3,12 @@
 //! [`surface`] welds and validates the geometry whose triangles amber-mesh reads (STL with CAD
 //! face ids, plain STL, OBJ); [`mod@remesh`] adapts the surface to a sizing field, keeping CAD
 //! faces, curves and corners; [`tetgen`] fills a closed surface with tets following the same
-//! field; [`generate_3d`] runs both, capped by curvature and by an element budget. Exact
-//! predicates and triangle intersection tests are private helpers.
+//! field; [`generate_3d`] runs both, capped by curvature and by an element budget. Triangle
+//! intersection tests are private helpers; the exact predicates are the crate's.
 
 mod distance;
 mod generate;
 mod intersect;
-mod predicates;
 pub mod remesh;
 pub mod surface;
 pub mod tetgen;

@@ -16,8 +16,8 @@ use amber_mesh::{FacetAdjacency, Mesh3, MeshError, read_surface};
 use nalgebra::Vector3;
 
 use super::intersect::intersecting_pairs;
-use super::predicates::orient2d;
 use super::tetgen::Plc;
+use crate::predicates::orient2d;
 
 /// A triangle surface: vertices, triangles (zero-based vertex indices) and the CAD face id of
 /// every triangle. Indices are in range and vertices finite ([`Surface::new`] checks); whether

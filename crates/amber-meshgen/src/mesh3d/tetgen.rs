@@ -16,7 +16,7 @@ use rstar::RTree;
 use rstar::primitives::GeomWithData;
 use tetgen_sys as sys;
 
-use super::predicates::orient3d;
+use crate::predicates::orient3d;
 
 /// A piecewise linear complex made of triangles: every triangle is one facet of TetGen's input,
 /// carrying a marker (the CAD face id) that reappears on the output boundary triangles.

@@ -1,8 +1,10 @@
-//! Exact orientation predicates for `f64` points, as `Ordering`s in our sign conventions, on the
-//! `robust` crate (Shewchuk's adaptive predicates, which spade uses too: a floating-point filter
-//! with his error bounds, and where it cannot decide, the determinant in exact expansion
-//! arithmetic). Exact as long as no product under- or overflows, which holds for any
-//! coordinates between about 1e-70 and 1e70 in magnitude.
+//! Exact orientation and in-circle predicates for `f64` points, as `Ordering`s in our sign
+//! conventions, on the `robust` crate (Shewchuk's adaptive predicates, which spade uses too: a
+//! floating-point filter with his error bounds, and where it cannot decide, the determinant in
+//! exact expansion arithmetic). The orientations are exact as long as no product under- or
+//! overflows, which holds for any coordinates between about 1e-70 and 1e70 in magnitude; the
+//! in-circle test, of degree four, within spade's `MIN_ALLOWED_VALUE`..`MAX_ALLOWED_VALUE`, which
+//! `PolygonDomain` enforces.
 
 use std::cmp::Ordering;
 
@@ -23,6 +25,13 @@ pub(crate) fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> Ordering {
     sign(robust::orient2d(p(a), p(b), p(c)))
 }
 
+/// Sign of the lifted determinant of a, b, c, d: `Greater` when d lies strictly inside the circle
+/// through the counter-clockwise a, b, c.
+pub(crate) fn incircle(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> Ordering {
+    let p = |p: [f64; 2]| Coord { x: p[0], y: p[1] };
+    sign(robust::incircle(p(a), p(b), p(c), p(d)))
+}
+
 /// The sign of an exact determinant (NaN input: `Equal`).
 fn sign(det: f64) -> Ordering {
     det.partial_cmp(&0.0).unwrap_or(Ordering::Equal)
@@ -40,6 +49,10 @@ mod tests {
         assert_eq!(orient3d(o, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.3, 0.3, 0.0]), Ordering::Equal);
         assert_eq!(orient2d([0.0, 0.0], [1.0, 0.0], [0.0, 1.0]), Ordering::Greater);
         assert_eq!(orient2d([0.0, 0.0], [1.0, 1.0], [3.0, 3.0]), Ordering::Equal);
+        let [a, b, c] = [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]];
+        assert_eq!(incircle(a, b, c, [0.0, -0.5]), Ordering::Greater);
+        assert_eq!(incircle(a, b, c, [0.0, -1.0]), Ordering::Equal);
+        assert_eq!(incircle(a, b, c, [0.0, -1.5]), Ordering::Less);
     }
 
     /// Exact reference for integer coordinates: differences below 2^40 keep the determinant in i128.
