@@ -720,12 +720,15 @@ mod tests {
     }
 
     #[test]
-    fn same_input_gives_the_same_mesh() {
+    fn same_input_gives_the_same_mesh_at_any_thread_count() {
         let domain = PolygonDomain::lshape([0.4, 0.6]).unwrap();
         let field = FnSize(|x: [f64; 2]| 0.01 + 0.1 * x[0]);
         let a = generate_2d(&domain, &field, &Mesh2dParams::default()).unwrap();
         let b = generate_2d(&domain, &field, &Mesh2dParams::default()).unwrap();
         assert_eq!(a, b);
+        let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        let c = one_thread.install(|| generate_2d(&domain, &field, &Mesh2dParams::default())).unwrap();
+        assert_eq!(a, c);
     }
 
     #[test]
