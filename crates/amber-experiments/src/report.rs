@@ -27,8 +27,7 @@ fn create_parent(path: &Path) -> anyhow::Result<()> {
 
 /// CPU model, clock, widest vector instructions, core count, thread count, memory and load
 /// average, for the record: the one machine description of every results file, benchmarks
-/// included. Machines sold under one model name differ: matmuls run about 3× faster on an AVX-512
-/// "AMD EPYC" than on an AVX2 one at 2 GHz.
+/// included. The model name alone does not tell machines apart whose matmul speeds differ.
 pub fn machine() -> serde_json::Value {
     let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
     let field = |name: &str| {
