@@ -13,7 +13,7 @@ use candle_core::{Layout, Result, Shape, Tensor, bail};
 use super::gemm::{Strided, for_each_item, matmul, sum_over_items};
 use super::{Float, SharedMut, image_dims};
 
-/// Scratch elements of one im2col tile (2 MB in f32): big enough for efficient products, small
+/// Scratch elements of one im2col tile (512 KB in f32): big enough for efficient products, small
 /// enough to stay in cache between the unfold and the product.
 const TILE_ELEMENTS: usize = 1 << 17;
 
