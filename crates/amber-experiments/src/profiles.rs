@@ -5,7 +5,6 @@
 //! it is: docs/PROFILES.md.
 
 use amber_tasks::LOG_SIZE_COLUMN;
-use amber_tasks::part::GEOMETRY_INPUTS;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
 use amber_train::{CnnConfig, MethodConfig, Profile, TrainingConfig};
 
@@ -45,6 +44,13 @@ impl Task {
     }
 }
 
+/// The geometry inputs (of `amber_tasks::part::GEOMETRY_INPUTS`) the Console and folder profiles
+/// read. Where the geometry is (boundary, feature curves): Console val 0.235 → 0.167; and how
+/// curved it is there: cross-validation fold 1 0.335 → 0.198, fold 0 0.339 → 0.218. The wall
+/// thickness is offered but not measured yet.
+const PROFILE_GEOMETRY_INPUTS: [&str; 4] =
+    ["log_boundary_distance", "log_feature_distance", "feature_turn", "log_curvature_radius"];
+
 /// AMBER's configuration of `task` under `profile` (before the method's labels and the seed).
 /// Console is one folder dataset of 3D parts meshed by human experts: it and every 3D folder get
 /// the same values, so `amber train --data` on the Console folder trains what `reproduce console`
@@ -67,10 +73,8 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
             if task != Task::Console && !config.inputs.iter().any(|i| i == LOG_SIZE_COLUMN) {
                 config.inputs.push(LOG_SIZE_COLUMN.into());
             }
-            // Where the geometry is (boundary, feature curves): Console val 0.235 → 0.167; and
-            // how curved it is there: cross-validation fold 1 0.335 → 0.198, fold 0 0.339 → 0.218.
             if profile != Profile::Paper {
-                config.inputs.extend(GEOMETRY_INPUTS.map(String::from));
+                config.inputs.extend(PROFILE_GEOMETRY_INPUTS.map(String::from));
             }
             if task.dimension() == 3 {
                 // Spec §9: latent width 128.
@@ -157,7 +161,9 @@ mod tests {
             let inputs = amber_config(Task::Folder { dimension: 3 }, profile).inputs;
             assert_eq!(inputs[0], LOG_SIZE_COLUMN, "{profile:?}");
             let geometric: Vec<&str> = inputs[1..].iter().map(String::as_str).collect();
-            let expected: &[&str] = if profile == Profile::Paper { &[] } else { &GEOMETRY_INPUTS };
+            let offered = amber_tasks::part::GEOMETRY_INPUTS;
+            assert!(geometric.iter().all(|input| offered.contains(input)), "{profile:?}: {geometric:?}");
+            let expected: &[&str] = if profile == Profile::Paper { &[] } else { &PROFILE_GEOMETRY_INPUTS };
             assert_eq!(geometric, expected, "{profile:?}");
             let (mut console, mut folder) =
                 (amber_config(Task::Console, profile), amber_config(Task::Folder { dimension: 3 }, profile));

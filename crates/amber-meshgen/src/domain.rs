@@ -8,6 +8,7 @@ use rstar::{PointDistance, RTree};
 use serde::{Deserialize, Serialize};
 
 use crate::MeshgenError;
+use crate::ray::{first_hit, ray_segment};
 
 /// A polygonal domain: one outer ring and any number of holes (each a closed ring of at least
 /// three vertices, the closing edge implied).
@@ -302,6 +303,35 @@ impl PolygonDistance {
     pub fn to_corner(&self, p: [f64; 2]) -> Option<(f64, f64)> {
         self.corners.nearest_neighbor(p).map(|c| (c.distance_2(&p).sqrt(), c.data))
     }
+
+    /// The width of the domain at `p`: the chord through `p` along the normal of the nearest
+    /// boundary edge, from the boundary on one side to the boundary on the other. Infinite where
+    /// a ray leaves without meeting the boundary (a point outside).
+    pub fn wall_thickness(&self, p: [f64; 2]) -> f64 {
+        let Some(nearest) = self.edges.nearest_neighbor(p) else {
+            return f64::INFINITY;
+        };
+        let (a, b) = (nearest.geom().from, nearest.geom().to);
+        let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let envelope = self.edges.root().envelope();
+        let (lo, hi) = (envelope.lower(), envelope.upper());
+        let limit = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+        if length == 0.0 || limit == 0.0 {
+            return f64::INFINITY;
+        }
+        let normal = [(a[1] - b[1]) / length, (b[0] - a[0]) / length];
+        // The ray towards the nearest edge meets it at about the distance to it.
+        let start = 2.0 * nearest.distance_2(&p).sqrt() + 1e-6 * limit;
+        let along = |d: [f64; 2]| {
+            first_hit(&self.edges, p, d, start, limit, |e| {
+                ray_segment(p, d, [e.geom().from, e.geom().to], 1e-12 * limit)
+            })
+        };
+        match (along(normal), along(normal.map(|x| -x))) {
+            (Some(a), Some(b)) => a + b,
+            _ => f64::INFINITY,
+        }
+    }
 }
 
 fn ring_area(ring: &[[f64; 2]]) -> f64 {
@@ -434,6 +464,19 @@ mod tests {
         assert!((d.area() - 0.5).abs() < 1e-15);
         let bowtie = r#"{"outer": [[0,0],[1,1],[1,0],[0,1]]}"#;
         assert!(serde_json::from_str::<PolygonDomain>(bowtie).unwrap_err().to_string().contains("self-intersecting"));
+    }
+
+    /// A square frame with walls 0.3 wide: the chord along the nearest side's normal crosses
+    /// one wall; outside the frame no ray meets the boundary twice.
+    #[test]
+    fn a_frame_is_as_wide_as_its_walls() {
+        let square = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let hole = vec![[0.3, 0.3], [0.3, 0.7], [0.7, 0.7], [0.7, 0.3]];
+        let distance = PolygonDistance::new(&PolygonDomain::new(square, vec![hole]).unwrap());
+        for p in [[0.1, 0.5], [0.5, 0.9], [0.5, 0.1], [0.25, 0.6]] {
+            assert!((distance.wall_thickness(p) - 0.3).abs() < 1e-12, "{p:?}: {}", distance.wall_thickness(p));
+        }
+        assert_eq!(distance.wall_thickness([2.0, 0.5]), f64::INFINITY);
     }
 
     /// Near a round hole the boundary's radius of curvature is the hole's; along the square's

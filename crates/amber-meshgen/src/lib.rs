@@ -9,6 +9,7 @@ mod error;
 mod mesh2d;
 mod predicates;
 mod quality;
+mod ray;
 mod sizing;
 
 pub use domain::{PolygonDistance, PolygonDomain};

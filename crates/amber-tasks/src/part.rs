@@ -94,30 +94,38 @@ pub(crate) fn polygon_domain_of_mesh(path: &Path, mesh: &Mesh2) -> Result<Polygo
 /// curve where two CAD faces meet in 3D, a corner in 2D), and how far the boundary turns at that
 /// feature (radians), and the log radius of curvature of the boundary nearest to the midpoint
 /// (within a CAD face in 3D, between corners in 2D; capped at the geometry's extent: a round hole
-/// shows its radius, a flat face or straight edge the cap). They come from the geometry alone, so
-/// every dataset has them.
-pub const GEOMETRY_INPUTS: [&str; 4] =
-    ["log_boundary_distance", "log_feature_distance", "feature_turn", "log_curvature_radius"];
+/// shows its radius, a flat face or straight edge the cap), and the log thickness of the wall
+/// through the midpoint (the chord along the nearest boundary's normal; capped at the extent).
+/// They come from the geometry alone, so every dataset has them.
+pub const GEOMETRY_INPUTS: [&str; 5] =
+    ["log_boundary_distance", "log_feature_distance", "feature_turn", "log_curvature_radius", "log_wall_thickness"];
 
 /// The columns of [`GEOMETRY_INPUTS`] for elements with midpoints `midpoints`, given the distance
-/// to the boundary of a point with the boundary's radius of curvature there, and its distance to
-/// the nearest feature with the feature's turn. Lengths are clamped to [10⁻⁶, 1] × the
-/// geometry's extent `extent` before the logarithm; without features, the feature lies at
-/// `extent` and turns by 0.
+/// to the boundary of a point with the boundary's radius of curvature there, its distance to
+/// the nearest feature with the feature's turn, and the wall's thickness there. Lengths are
+/// clamped to [10⁻⁶, 1] × the geometry's extent `extent` before the logarithm; without
+/// features, the feature lies at `extent` and turns by 0.
 fn geometry_columns<const D: usize>(
     midpoints: &[[f64; D]],
     extent: f64,
     to_boundary: impl Fn([f64; D]) -> (f64, f64) + Sync,
     to_feature: impl Fn([f64; D]) -> Option<(f64, f64)> + Sync,
+    wall_thickness: impl Fn([f64; D]) -> f64 + Sync,
 ) -> Vec<Column> {
     let floor = 1e-6 * extent;
-    let rows: Vec<[f64; 4]> = midpoints
+    let log_length = |x: f64| x.clamp(floor, extent).ln();
+    let rows: Vec<[f64; 5]> = midpoints
         .par_iter()
         .map(|&p| {
             let (to_boundary, radius) = to_boundary(p);
             let (to_feature, turn) = to_feature(p).unwrap_or((extent, 0.0));
-            let radius = radius.clamp(floor, extent);
-            [to_boundary.max(floor).ln(), to_feature.max(floor).ln(), turn, radius.ln()]
+            [
+                to_boundary.max(floor).ln(),
+                to_feature.max(floor).ln(),
+                turn,
+                log_length(radius),
+                log_length(wall_thickness(p)),
+            ]
         })
         .collect();
     GEOMETRY_INPUTS
@@ -244,8 +252,13 @@ impl Domain<3> for SolidPart {
     /// computed by the graph.
     fn columns(&self, mesh: &Mesh<3>) -> Result<Vec<Column>, ProblemError> {
         let (midpoints, distance, extent) = (mesh.midpoints(), &self.distance, self.extent);
-        let mut columns =
-            geometry_columns(&midpoints, extent, |p| distance.to_surface(p), |p| distance.to_feature_curve(p));
+        let mut columns = geometry_columns(
+            &midpoints,
+            extent,
+            |p| distance.to_surface(p),
+            |p| distance.to_feature_curve(p),
+            |p| distance.wall_thickness(p),
+        );
         columns.extend(self.inputs.columns(&midpoints, extent));
         Ok(columns)
     }
@@ -297,7 +310,13 @@ impl PlanarGeometry {
     /// The [`GEOMETRY_INPUTS`] of elements with midpoints `midpoints`.
     pub(crate) fn columns(&self, midpoints: &[[f64; 2]]) -> Vec<Column> {
         let distance = &self.distance;
-        geometry_columns(midpoints, self.extent, |p| distance.to_boundary(p), |p| distance.to_corner(p))
+        geometry_columns(
+            midpoints,
+            self.extent,
+            |p| distance.to_boundary(p),
+            |p| distance.to_corner(p),
+            |p| distance.wall_thickness(p),
+        )
     }
 }
 
@@ -345,7 +364,11 @@ mod tests {
         let columns = part.columns(&part.initial_mesh).unwrap();
         let names: Vec<&str> = columns.iter().map(|c| c.name.as_str()).collect();
         assert_eq!(names, GEOMETRY_INPUTS);
-        let [boundary, feature, turn, radius] = [0, 1, 2, 3].map(|i| &columns[i].values);
+        let [boundary, feature, turn, radius, thickness] = [0, 1, 2, 3, 4].map(|i| &columns[i].values);
+        // The upper arm of the L is 0.5 wide: near its left side the chord crosses it.
+        let arm = part.initial_mesh.midpoints().iter().position(|&[x, y]| x < 0.15 && (y - 0.75).abs() < 0.1);
+        let arm = arm.expect("an element in the upper arm");
+        assert!((thickness[arm] - 0.5f64.ln()).abs() < 1e-9, "{}", thickness[arm].exp());
         // The L-shape's sides are straight: its curvature radius is the cap everywhere.
         assert!(radius.iter().all(|&r| (r - part.geometry.extent.ln()).abs() < 1e-12));
         assert!(boundary.iter().all(|v| v.is_finite()) && boundary.len() == part.initial_mesh.num_elements());

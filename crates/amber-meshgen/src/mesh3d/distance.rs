@@ -7,6 +7,7 @@ use rstar::primitives::{GeomWithData, Line};
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
 use super::surface::Surface;
+use crate::ray::{first_hit, ray_triangle};
 
 /// R-trees over a surface's triangles and its feature curves, for exact nearest-distance queries.
 #[derive(Clone, Debug)]
@@ -68,6 +69,31 @@ impl SurfaceDistance {
     /// the two faces that meet there, or `None` for a surface of one CAD face.
     pub fn to_feature_curve(&self, p: [f64; 3]) -> Option<(f64, f64)> {
         self.curves.nearest_neighbor(p).map(|edge| (edge.distance_2(&p).sqrt(), edge.data))
+    }
+
+    /// The thickness of the wall at `p`: the chord through `p` along the normal of the nearest
+    /// triangle, from the surface on one side to the surface on the other. Infinite where a ray
+    /// leaves without meeting the surface (a point outside, an open surface).
+    pub fn wall_thickness(&self, p: [f64; 3]) -> f64 {
+        let Some(nearest) = self.triangles.nearest_neighbor(p) else {
+            return f64::INFINITY;
+        };
+        let normal = unit_normal(nearest.geom().0);
+        let envelope = self.triangles.root().envelope();
+        let limit = (Vector3::from(envelope.upper()) - Vector3::from(envelope.lower())).norm();
+        if normal == Vector3::zeros() || limit == 0.0 {
+            return f64::INFINITY;
+        }
+        // The ray towards the nearest triangle meets it at about the distance to it.
+        let start = 2.0 * nearest.distance_2(&p).sqrt() + 1e-6 * limit;
+        let along = |d: Vector3<f64>| {
+            let d = d.into();
+            first_hit(&self.triangles, p, d, start, limit, |t| ray_triangle(p, d, t.geom().0, 1e-12 * limit))
+        };
+        match (along(normal), along(-normal)) {
+            (Some(a), Some(b)) => a + b,
+            _ => f64::INFINITY,
+        }
     }
 }
 
@@ -189,5 +215,16 @@ mod tests {
         let near_an_edge = [0.1, 0.2, 0.5];
         assert!((distance.to_surface(near_an_edge).0 - 0.1).abs() < 1e-12);
         assert!((distance.to_feature_curve(near_an_edge).unwrap().0 - 0.05f64.sqrt()).abs() < 1e-12);
+    }
+
+    /// Across the unit cube the wall is 1 thick wherever the chord runs along the nearest face's
+    /// normal; outside it no ray meets the surface twice.
+    #[test]
+    fn the_unit_cube_is_one_thick() {
+        let distance = SurfaceDistance::new(&unit_cube());
+        for p in [[0.5, 0.5, 0.5], [0.1, 0.2, 0.5], [0.9, 0.3, 0.7], [0.5, 0.02, 0.98]] {
+            assert!((distance.wall_thickness(p) - 1.0).abs() < 1e-12, "{p:?}: {}", distance.wall_thickness(p));
+        }
+        assert_eq!(distance.wall_thickness([2.0, 0.5, 0.5]), f64::INFINITY);
     }
 }

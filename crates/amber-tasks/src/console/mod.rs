@@ -131,9 +131,11 @@ mod tests {
     /// train/014 is a bent plate with a round hole, where its expert refines most:
     /// `log_curvature_radius` marks the hole. Its finest 5 % of expert elements lie where the
     /// nearest surface's radius of curvature is at most a fifth of the median element's (whose
-    /// nearest surface is flat: the cap, the part's extent).
+    /// nearest surface is flat: the cap, the part's extent). The wall thickness there is the
+    /// chord from the hole's wall in the plate's plane (15.8 mm), not across the plate (2.9 mm at
+    /// the median element).
     #[test]
-    fn the_curvature_input_marks_where_the_expert_refines() {
+    fn the_geometry_inputs_mark_where_the_expert_refines() {
         let Some(data) = amber_testdata::shared("data/console") else { return };
         let mut experts = read_experts::<3>(&Split::Train.dir(&data), Some(14)).unwrap();
         let expert = experts.pop().unwrap();
@@ -150,6 +152,12 @@ mod tests {
         let cap = radius.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         assert_eq!(all, cap, "flat at the median element");
         assert!(finest < all - 5f64.ln(), "log radius {finest} at the finest elements, {all} at the median");
+        let thickness = &columns.iter().find(|c| c.name == "log_wall_thickness").unwrap().values;
+        let finest: Vec<f64> = (0..sizes.len()).filter(|&e| sizes[e] <= cut).map(|e| thickness[e]).collect();
+        let (finest, all) = (median(&finest).exp(), median(thickness).exp());
+        println!("wall thickness: {finest} mm at the finest elements, {all} mm at the median");
+        assert!((2.0..4.0).contains(&all), "{all} mm at the median element");
+        assert!(finest > 1.2 * all, "{finest} mm at the finest elements, {all} at the median");
     }
 
     /// val/002 through the folder loader: its reference surface, a uniform M⁰, the expert; then
