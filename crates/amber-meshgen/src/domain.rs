@@ -8,7 +8,7 @@ use rstar::{PointDistance, RTree};
 use serde::{Deserialize, Serialize};
 
 use crate::MeshgenError;
-use crate::ray::{first_hit, ray_segment};
+use crate::ray::{chord, ray_segment};
 
 /// A polygonal domain: one outer ring and any number of holes (each a closed ring of at least
 /// three vertices, the closing edge implied).
@@ -313,24 +313,13 @@ impl PolygonDistance {
         };
         let (a, b) = (nearest.geom().from, nearest.geom().to);
         let length = (b[0] - a[0]).hypot(b[1] - a[1]);
-        let envelope = self.edges.root().envelope();
-        let (lo, hi) = (envelope.lower(), envelope.upper());
-        let limit = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
-        if length == 0.0 || limit == 0.0 {
+        if length == 0.0 {
             return f64::INFINITY;
         }
         let normal = [(a[1] - b[1]) / length, (b[0] - a[0]) / length];
-        // The ray towards the nearest edge meets it at about the distance to it.
-        let start = 2.0 * nearest.distance_2(&p).sqrt() + 1e-6 * limit;
-        let along = |d: [f64; 2]| {
-            first_hit(&self.edges, p, d, start, limit, |e| {
-                ray_segment(p, d, [e.geom().from, e.geom().to], 1e-12 * limit)
-            })
-        };
-        match (along(normal), along(normal.map(|x| -x))) {
-            (Some(a), Some(b)) => a + b,
-            _ => f64::INFINITY,
-        }
+        chord(&self.edges, p, normal, nearest.distance_2(&p).sqrt(), |e, d, tolerance| {
+            ray_segment(p, d, [e.geom().from, e.geom().to], tolerance)
+        })
     }
 }
 

@@ -52,7 +52,7 @@ where
 /// object of `tree`, by `hit` (an object's exact t, if the ray meets it), up to `limit`.
 /// Segments of growing length, starting at `start`, keep the search near the origin: walls are
 /// usually much closer than `limit`.
-pub(crate) fn first_hit<const D: usize, T>(
+fn first_hit<const D: usize, T>(
     tree: &RTree<T>,
     origin: [f64; D],
     direction: [f64; D],
@@ -73,6 +73,35 @@ where
             return nearest;
         }
         length = (2.0 * length).min(limit);
+    }
+}
+
+/// The chord through `p` along the unit `normal`: the distance to the first object of `tree`
+/// ahead plus the first behind, by `hit` (an object's exact t along a direction, past a
+/// tolerance); infinite where a ray meets nothing. `near` is the distance from `p` to the
+/// nearest object, which the ray towards it meets at about that distance.
+pub(crate) fn chord<const D: usize, T>(
+    tree: &RTree<T>,
+    p: [f64; D],
+    normal: [f64; D],
+    near: f64,
+    hit: impl Fn(&T, [f64; D], f64) -> Option<f64>,
+) -> f64
+where
+    [f64; D]: Point<Scalar = f64>,
+    T: RTreeObject<Envelope = AABB<[f64; D]>>,
+{
+    let envelope = tree.root().envelope();
+    let (lo, hi) = (envelope.lower(), envelope.upper());
+    let limit = (0..D).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    if limit == 0.0 {
+        return f64::INFINITY;
+    }
+    let start = 2.0 * near + 1e-6 * limit;
+    let along = |d: [f64; D]| first_hit(tree, p, d, start, limit, |object| hit(object, d, 1e-12 * limit));
+    match (along(normal), along(normal.map(|x| -x))) {
+        (Some(ahead), Some(behind)) => ahead + behind,
+        _ => f64::INFINITY,
     }
 }
 

@@ -7,7 +7,7 @@ use rstar::primitives::{GeomWithData, Line};
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
 use super::surface::Surface;
-use crate::ray::{first_hit, ray_triangle};
+use crate::ray::{chord, ray_triangle};
 
 /// R-trees over a surface's triangles and its feature curves, for exact nearest-distance queries.
 #[derive(Clone, Debug)]
@@ -79,21 +79,12 @@ impl SurfaceDistance {
             return f64::INFINITY;
         };
         let normal = unit_normal(nearest.geom().0);
-        let envelope = self.triangles.root().envelope();
-        let limit = (Vector3::from(envelope.upper()) - Vector3::from(envelope.lower())).norm();
-        if normal == Vector3::zeros() || limit == 0.0 {
+        if normal == Vector3::zeros() {
             return f64::INFINITY;
         }
-        // The ray towards the nearest triangle meets it at about the distance to it.
-        let start = 2.0 * nearest.distance_2(&p).sqrt() + 1e-6 * limit;
-        let along = |d: Vector3<f64>| {
-            let d = d.into();
-            first_hit(&self.triangles, p, d, start, limit, |t| ray_triangle(p, d, t.geom().0, 1e-12 * limit))
-        };
-        match (along(normal), along(-normal)) {
-            (Some(a), Some(b)) => a + b,
-            _ => f64::INFINITY,
-        }
+        chord(&self.triangles, p, normal.into(), nearest.distance_2(&p).sqrt(), |t, d, tolerance| {
+            ray_triangle(p, d, t.geom().0, tolerance)
+        })
     }
 }
 
