@@ -1,7 +1,8 @@
 //! Repository hygiene, enforced by plain `cargo test`: every Rust file starts with a `//!` doc
 //! comment; no test is skipped with the ignore attribute or expects a panic; no crate depends on
 //! a crate above it in the layering table of docs/ARCHITECTURE.md, nor on an external crate
-//! confined to another layer there; every declared dependency is used.
+//! confined to another layer there; every declared dependency is used; only the binaries read
+//! environment variables.
 
 use std::path::{Path, PathBuf};
 
@@ -95,6 +96,23 @@ fn workspace_crates() -> Vec<(String, PathBuf)> {
     crates.push(("xtask".into(), root().join("xtask")));
     crates.sort();
     crates
+}
+
+/// Only the binaries read environment variables (docs/ARCHITECTURE.md, cross-cutting concerns),
+/// so what a library does follows from its arguments; amber-testdata, a dev-dependency, reads
+/// where the shared data is.
+#[test]
+fn only_the_binaries_read_environment_variables() {
+    let mut offenders = Vec::new();
+    for (name, dir) in workspace_crates() {
+        if ["amber-cli", "amber-testdata", "xtask"].contains(&name.as_str()) {
+            continue;
+        }
+        let mut files = Vec::new();
+        rust_files(&dir.join("src"), &mut files);
+        offenders.extend(files.into_iter().filter(|f| std::fs::read_to_string(f).unwrap().contains("env::var")));
+    }
+    assert!(offenders.is_empty(), "libraries that read environment variables: {offenders:#?}");
 }
 
 fn is_ours(dep: &str) -> bool {

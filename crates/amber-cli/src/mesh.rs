@@ -9,6 +9,7 @@ use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, MeshData, read_any_mesh, read_mesh
 use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
 use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
+use amber_tasks::cad::is_cad;
 use amber_tasks::part::{
     FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, read_polygon_domain, read_solid_surface,
 };
@@ -21,7 +22,8 @@ use clap::Args;
 #[derive(Args)]
 pub struct MeshArgs {
     /// The geometry: `lshape` (with --corner), `square`, a polygon JSON
-    /// `{"outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}`, a closed surface (.stl, .obj), or
+    /// `{"outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}`, a closed surface (.stl, .obj), a
+    /// CAD file (.step, .stp, .iges, .igs, .brep; tessellated by gmsh, which must be installed), or
     /// a 2D or 3D mesh file whose boundary is the geometry. With --problem it may be left out: the
     /// problem's own domain is meshed.
     geometry: Option<String>,
@@ -104,9 +106,12 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             mesh_domain(args, &trained, part, expert, steps)
         }
         Task::Console | Task::Folder { dimension: 3 } => {
-            let geometry = args.geometry.as_deref().context("give the geometry to mesh: a closed STL or a tet mesh")?;
+            let geometry = args
+                .geometry
+                .as_deref()
+                .context("give the geometry to mesh: a closed STL, a STEP file or a tet mesh")?;
             let path = Path::new(geometry);
-            let surface = read_solid_surface(path, args.feature_angle)?;
+            let surface = read_solid_surface(path, args.feature_angle, card.initial_size)?;
             let mut part = SolidPart::new(part_name(geometry), surface, card.initial_size)
                 .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
             part.inputs = part_inputs(args)?;
@@ -293,7 +298,7 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
     let start = Instant::now();
     if is_solid(geometry) {
         let h: f64 = size.parse().with_context(|| format!("--size {size}: a 3D geometry takes a constant size"))?;
-        let surface = read_solid_surface(Path::new(geometry), args.feature_angle)?;
+        let surface = read_solid_surface(Path::new(geometry), args.feature_angle, h)?;
         let params = Mesh3dParams::default().with_max_elements(args.max_elements);
         let mesh = generate_3d(&surface, &ConstantSize(h), &params).context("mesh generation failed")?;
         write_output(&mesh, &args.output)?;
@@ -332,7 +337,9 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
 fn is_solid(geometry: &str) -> bool {
     let path = Path::new(geometry);
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    matches!(extension.as_deref(), Some("stl" | "obj")) || matches!(read_any_mesh(path), Ok(AnyMesh::Three(..)))
+    matches!(extension.as_deref(), Some("stl" | "obj"))
+        || is_cad(path)
+        || matches!(read_any_mesh(path), Ok(AnyMesh::Three(..)))
 }
 
 fn mesh_with<F: SizingField<2>>(

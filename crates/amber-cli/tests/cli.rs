@@ -409,3 +409,27 @@ fn every_shipped_model_meshes_a_geometry_of_its_task() {
         assert!((total / volume - 1.0).abs() < 5e-3, "{name}: volume {total} for {volume}");
     }
 }
+
+/// A STEP file is a geometry like its gmsh-made reference surface: `amber mesh part.step`
+/// tessellates it through gmsh and fills it. Reads `../shared/`; needs gmsh.
+#[test]
+fn meshes_a_step_file_through_gmsh() {
+    let Some(data) = amber_testdata::shared("data/console") else { return };
+    if amber_tasks::cad::Gmsh::default().version().is_none() {
+        return amber_testdata::skip("gmsh is not on the PATH (`pip install gmsh`)");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("part.msh");
+    let output =
+        amber().args(["mesh", "--size", "3"]).arg(data.join("val/002.step")).arg("-o").arg(&out).output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let reference = amber_meshgen::mesh3d::Surface::load(
+        data.join("reference_surface/val/002.stl"),
+        amber_mesh::StlFaceIds::FromFile,
+    )
+    .unwrap()
+    .0
+    .enclosed_volume();
+    let total = amber_mesh::read_mesh::<3>(&out).unwrap().total_volume();
+    assert!((total / reference - 1.0).abs() < 5e-3, "volume {total} for {reference}");
+}

@@ -5,14 +5,16 @@
 //! DIR/dataset.json                       optional: settings a folder cannot say (DatasetSettings)
 //! DIR/train/<stem>.<mesh>                one expert mesh per part, any format amber reads
 //! DIR/train/<stem>.stl|.obj|.json        optional geometry beside it (3D surface, 2D polygon)
+//! DIR/train/<stem>.step|.stp|.iges|.igs|.brep   or its CAD file (3D, read through gmsh)
 //! DIR/train/<stem>.inputs.json           optional inputs of the part (named scalars and points)
 //! DIR/val/…  [DIR/test/…]
 //! DIR/reference_surface/<split>/<stem>.stl|.obj|.json   the geometry, when not beside the mesh
 //! ```
 //!
 //! A file is an expert mesh when `amber_mesh::read_mesh` reads its extension (a `.json` beside a
-//! mesh of the same stem is that mesh's polygon instead); other files (`.step`, notes) are
-//! ignored. A part's inputs ([`PartInputs`]) are node inputs a model may read; every part of a
+//! mesh of the same stem is that mesh's polygon instead); other files (notes) are ignored. A
+//! surface, beside the mesh or under `reference_surface/`, is preferred to a CAD file, which
+//! gmsh tessellates at every read (a second or two per part). A part's inputs ([`PartInputs`]) are node inputs a model may read; every part of a
 //! dataset has the same names or none. The dimension comes from the files (tets: 3D, triangles: 2D). Without a geometry
 //! file, the expert mesh's own boundary is the geometry. A part is a [`FolderDomain`]:
 //! [`SolidPart`] in 3D, [`PlanarPart`] in 2D, with M⁰ a uniform mesh of one size for the whole
@@ -27,6 +29,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::TaskError;
+use crate::cad::CAD_EXTENSIONS;
 use crate::expert::extent_mismatch;
 use crate::part::{
     FEATURE_ANGLE_DEGREES, PART_INPUTS_SUFFIX, PartInputs, PlanarPart, SolidPart, polygon_domain_of_mesh,
@@ -128,9 +131,10 @@ impl<const D: usize> Expert<D> {
     }
 }
 
-/// Whether `path` is a geometry file of a `D`-dimensional part (surfaces in 3D, polygons in 2D).
-fn geometry_extensions(dimension: usize) -> &'static [&'static str] {
-    if dimension == 3 { &["stl", "obj"] } else { &["json"] }
+/// The extensions of the geometry files of a `D`-dimensional part, in order of preference:
+/// surfaces, then CAD files in 3D; polygons in 2D.
+fn geometry_extensions(dimension: usize) -> &'static [&'static [&'static str]] {
+    if dimension == 3 { &[&["stl", "obj"], &CAD_EXTENSIONS] } else { &[&["json"]] }
 }
 
 fn extension(path: &Path) -> String {
@@ -194,12 +198,16 @@ fn read_part_mesh<const D: usize>(files: &[PathBuf]) -> Result<Option<(PathBuf, 
 /// The geometry file of part `stem` of the split `dir`: beside the mesh, else under
 /// `<root>/reference_surface/<split>/`.
 fn find_geometry(dir: &Path, stem: &str, files: &[PathBuf], mesh: &Path, dimension: usize) -> Option<PathBuf> {
-    let extensions = geometry_extensions(dimension);
-    if let Some(beside) = files.iter().find(|p| p.as_path() != mesh && extensions.contains(&extension(p).as_str())) {
-        return Some(beside.clone());
-    }
     let (root, split) = (dir.parent()?, dir.file_name()?);
-    extensions.iter().map(|e| root.join(GEOMETRY_DIR).join(split).join(format!("{stem}.{e}"))).find(|p| p.is_file())
+    geometry_extensions(dimension).iter().find_map(|extensions| {
+        let beside = files.iter().find(|p| p.as_path() != mesh && extensions.contains(&extension(p).as_str()));
+        beside.cloned().or_else(|| {
+            extensions
+                .iter()
+                .map(|e| root.join(GEOMETRY_DIR).join(split).join(format!("{stem}.{e}")))
+                .find(|p| p.is_file())
+        })
+    })
 }
 
 /// The inputs file of part `stem` of the split `dir`: beside the mesh, else under
@@ -313,7 +321,7 @@ fn initial_mesh_error<const D: usize>(expert: &Expert<D>, error: impl std::fmt::
 impl FolderDomain<3> for SolidPart {
     fn from_expert(expert: &Expert<3>, initial_size: f64, settings: &DatasetSettings) -> Result<Self, TaskError> {
         let surface = match &expert.geometry {
-            Some(path) => read_solid_surface(path, settings.feature_angle())?,
+            Some(path) => read_solid_surface(path, settings.feature_angle(), initial_size)?,
             None => solid_surface_of_mesh(&expert.path, &expert.mesh, settings.feature_angle())?,
         };
         let bounds = amber_mesh::bounding_box(surface.vertices()).expect("a validated surface has vertices");
@@ -603,6 +611,52 @@ mod tests {
         write_boundary_stl(&larger.unwrap(), &stl);
         let err = load().unwrap_err().to_string();
         assert!(err.contains("cube.stl") && err.contains("encloses volume"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A CAD file beside a mesh is the part's geometry, unless a surface is there too (beside
+    /// the mesh or under `reference_surface/`).
+    #[test]
+    fn a_surface_is_preferred_to_a_cad_file() {
+        let dir = temp_dir("cad");
+        let train = Split::Train.dir(&dir);
+        std::fs::create_dir_all(&train).unwrap();
+        amber_mesh::write_mesh(&cube_tets([0.0; 3]), train.join("cube.vtk"), &amber_mesh::MeshData::default()).unwrap();
+        std::fs::write(train.join("cube.step"), "ISO-10303-21;\n").unwrap();
+        let geometry = || read_experts::<3>(&train, None).unwrap().pop().unwrap().geometry;
+        assert_eq!(geometry(), Some(train.join("cube.step")));
+        let reference = dir.join(GEOMETRY_DIR).join("train");
+        std::fs::create_dir_all(&reference).unwrap();
+        write_boundary_stl(&cube_tets([0.0; 3]), &reference.join("cube.stl"));
+        assert_eq!(geometry(), Some(reference.join("cube.stl")));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A Console part given as its expert mesh and STEP file only: gmsh's surface of the STEP
+    /// passes the check against the expert mesh (volume, bounding box), keeps the part's 11 CAD
+    /// faces, encloses the expert's volume to 0.1 % and bounds M⁰ (its chords on the bends and
+    /// hole cut 0.2 % off). Reads `../shared/data/console`; needs gmsh.
+    #[test]
+    fn a_part_with_a_step_file_loads_with_the_cad_faces() {
+        let Some(data) = amber_testdata::shared("data/console") else { return };
+        if crate::cad::Gmsh::default().version().is_none() {
+            return amber_testdata::skip("gmsh is not on the PATH (`pip install gmsh`)");
+        }
+        let dir = temp_dir("step-part");
+        let train = Split::Train.dir(&dir);
+        std::fs::create_dir_all(&train).unwrap();
+        for extension in ["nas", "step"] {
+            std::fs::copy(data.join(format!("train/014.{extension}")), train.join(format!("014.{extension}"))).unwrap();
+        }
+        let experts = read_experts::<3>(&train, None).unwrap();
+        assert_eq!(experts[0].geometry, Some(train.join("014.step")));
+        let size = crate::console::INITIAL_SIZE;
+        let part = problems::<3, SolidPart>(experts, size, &DatasetSettings::default()).unwrap().pop().unwrap();
+        assert_eq!(part.domain.surface.face_ids().iter().max(), Some(&11));
+        let expert_volume = part.expert_mesh.total_volume();
+        let (surface, initial) = (part.domain.surface.enclosed_volume(), part.initial_mesh().total_volume());
+        assert!((surface / expert_volume - 1.0).abs() < 1e-3, "surface {surface} vs expert {expert_volume}");
+        assert!((initial / expert_volume - 1.0).abs() < 1e-2, "M⁰ {initial} vs expert {expert_volume}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

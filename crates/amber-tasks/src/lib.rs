@@ -12,6 +12,7 @@
 //! Depends on the mesh, meshing, FEM, graph and metric layers; knows nothing of networks,
 //! training loops or candle, and never prints (progress is reported through a callback).
 
+pub mod cad;
 pub mod console;
 mod error;
 mod expert;

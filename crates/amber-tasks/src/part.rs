@@ -16,6 +16,7 @@ use amber_meshgen::{
 use rayon::prelude::*;
 
 use crate::TaskError;
+use crate::cad::{Gmsh, TESSELLATION_SIZE_PER_INITIAL_SIZE, is_cad};
 use crate::problem::{Column, Domain, ProblemError};
 
 /// The dihedral angle above which an edge of a surface without CAD faces separates two faces:
@@ -24,21 +25,27 @@ use crate::problem::{Column, Domain, ProblemError};
 pub const FEATURE_ANGLE_DEGREES: f64 = 30.0;
 
 /// The validated surface of a solid from a geometry file: a surface (`.stl`, `.obj`) whose CAD
-/// faces come from the file (the STL facet attribute or `solid` blocks, OBJ groups), or the
-/// boundary of a tet mesh in any format amber reads. A surface with a single face (a plain STL,
-/// a mesh boundary) is split into faces at edges sharper than `feature_angle` degrees, since the
+/// faces come from the file (the STL facet attribute or `solid` blocks, OBJ groups), a CAD file
+/// (STEP, IGES, BREP; tessellated by gmsh with triangles up to
+/// [`TESSELLATION_SIZE_PER_INITIAL_SIZE`] × `initial_size`, M⁰'s element size), or the boundary
+/// of a tet mesh in any format amber reads. A surface with a single face (a plain STL, a mesh
+/// boundary) is split into faces at edges sharper than `feature_angle` degrees, since the
 /// generator keeps vertices on their own face and curves.
-pub fn read_solid_surface(path: &Path, feature_angle: f64) -> Result<Surface, TaskError> {
+pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) -> Result<Surface, TaskError> {
     let geometry = |message: String| TaskError::Geometry { path: path.into(), message };
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    match extension.as_deref() {
-        Some("stl" | "obj") => {
-            let soup = read_surface(path, StlFaceIds::FromFile).map_err(|e| geometry(e.to_string()))?;
+    let soup = match extension.as_deref() {
+        Some("stl" | "obj") => Some(read_surface(path, StlFaceIds::FromFile).map_err(|e| geometry(e.to_string()))?),
+        _ if is_cad(path) => Some(Gmsh::default().tessellate(path, TESSELLATION_SIZE_PER_INITIAL_SIZE * initial_size)?),
+        _ => None,
+    };
+    match soup {
+        Some(soup) => {
             let surface =
                 Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(|e| geometry(e.to_string()))?;
             validated_solid(path, surface, feature_angle)
         }
-        _ => match read_any_mesh(path).map_err(|e| geometry(format!("neither a surface nor a tet mesh: {e}")))? {
+        None => match read_any_mesh(path).map_err(|e| geometry(format!("neither a surface nor a tet mesh: {e}")))? {
             AnyMesh::Three(mesh, _) => solid_surface_of_mesh(path, &mesh, feature_angle),
             AnyMesh::Two(..) => Err(geometry("holds triangles (a 2D geometry), not a solid".into())),
         },

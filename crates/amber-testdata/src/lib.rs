@@ -1,6 +1,6 @@
 //! Where the tests find the shared data and fixtures (`../shared/` beside the workspace: the
 //! Console bundle, the independently computed reference values), and the one message a test
-//! prints when it skips because they are absent. `$AMBER_SHARED` points elsewhere, e.g. from a
+//! prints when it skips because they (or a tool CI installs, such as gmsh) are absent. `$AMBER_SHARED` points elsewhere, e.g. from a
 //! checkout that does not sit next to `shared/`; `AMBER_REQUIRE_SHARED=1` (set by CI, which has
 //! the folder) turns every such skip into a failure. A dev-dependency only: no shipped code reads
 //! data from a fixed place.
@@ -22,10 +22,15 @@ pub fn shared(relative: &str) -> Option<PathBuf> {
     if path.exists() {
         return Some(path);
     }
-    let why = format!("{} is absent (set AMBER_SHARED to the folder holding data/ and fixtures/)", path.display());
+    skip(&format!("{} is absent (set AMBER_SHARED to the folder holding data/ and fixtures/)", path.display()));
+    None
+}
+
+/// Prints why the calling test skips (something CI has is absent here, `why` says what); with
+/// `AMBER_REQUIRE_SHARED` set to anything but `0` fails the calling test instead.
+pub fn skip(why: &str) {
     assert!(!required(), "AMBER_REQUIRE_SHARED is set: {why}");
     println!("skipping: {why}");
-    None
 }
 
 fn required() -> bool {
