@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use amber_experiments::{ModelCard, ProblemEvaluation, Task, resolve_model, write_atomic, write_json};
 use amber_mesh::Mesh;
+use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{Tile, mesh_gallery};
 use amber_tasks::Problem;
 use amber_tasks::folder::{DatasetSettings, FolderDomain, Split, mesh_dimension, problems, read_experts};
@@ -142,10 +143,11 @@ impl Run<'_> {
             rollouts.iter().zip(&parts).map(|(r, p)| ProblemEvaluation::of(r, p)).collect();
         let out = &self.args.out;
         std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
-        let mut pictures = Vec::new();
+        let (mut pictures, mut size_ratios) = (Vec::new(), Vec::new());
         for ((name, rollout), part) in names.iter().zip(&rollouts).zip(&parts) {
             let generated = &rollout.steps.last().context("no generation step")?.mesh;
             let expert = part.expert_mesh();
+            size_ratios.push(SizeRatios::of(&log_size_ratios(generated, expert)));
             let picture = format!("{}.png", name.replace(['/', '\\'], "-"));
             let row = vec![
                 tile(format!("{name}: generated, {} el.", generated.num_elements()), generated),
@@ -160,12 +162,12 @@ impl Run<'_> {
             "data": self.split,
             "steps": self.steps,
             "summary": summary,
-            "parts": names.iter().zip(&scores).zip(&pictures).map(|((name, score), picture)| {
-                serde_json::json!({ "name": name, "picture": picture, "evaluation": score })
+            "parts": names.iter().zip(&scores).zip(&pictures).zip(&size_ratios).map(|(((name, score), picture), ratios)| {
+                serde_json::json!({ "name": name, "picture": picture, "evaluation": score, "size_ratios": ratios })
             }).collect::<Vec<_>>(),
         });
         write_json(&out.join("evaluation.json"), &json)?;
-        write_atomic(&out.join("evaluation.md"), self.markdown(&names, &scores, &summary).as_bytes())?;
+        write_atomic(&out.join("evaluation.md"), self.markdown(&names, &scores, &size_ratios, &summary).as_bytes())?;
         println!(
             "{} parts of {}: mean normalised DCD {:.3} after {} steps; wrote {}",
             parts.len(),
@@ -178,24 +180,41 @@ impl Run<'_> {
     }
 
     /// The per-part table with the means, as `evaluation.md` holds it.
-    fn markdown(&self, names: &[String], scores: &[ProblemEvaluation], summary: &EvaluationSummary) -> String {
+    fn markdown(
+        &self,
+        names: &[String],
+        scores: &[ProblemEvaluation],
+        size_ratios: &[SizeRatios],
+        summary: &EvaluationSummary,
+    ) -> String {
         let mut md = format!(
             "# Evaluation of {} on {}\n\n{} ({}), {} generation steps; normalised DCD: 0 as good as the expert's \
-             own field re-meshed, 1 no better than M⁰.\n\n",
+             own field re-meshed, 1 no better than M⁰. Sizes ÷ expert's: each final element's size over the \
+             expert's element at its midpoint, 10th percentile, median, 90th percentile (above 1: coarser than \
+             the expert).\n\n",
             self.args.model.model,
             self.split.display(),
             self.card.method,
             self.card.data,
             self.steps
         );
-        md.push_str("| part | normalised DCD | DCD | volume difference | elements | expert elements |\n");
-        md.push_str("|---|---:|---:|---:|---:|---:|\n");
-        for (name, score) in names.iter().zip(scores) {
+        md.push_str(
+            "| part | normalised DCD | DCD | volume difference | elements | expert elements | sizes ÷ expert's |\n",
+        );
+        md.push_str("|---|---:|---:|---:|---:|---:|---:|\n");
+        for ((name, score), r) in names.iter().zip(scores).zip(size_ratios) {
             let last = score.last();
             let _ = writeln!(
                 md,
-                "| {name} | {:.3} | {:.4} | {:.3e} | {} | {} |",
-                last.normalised_dcd, last.dcd, last.volume_difference, last.elements, score.expert_elements
+                "| {name} | {:.3} | {:.4} | {:.3e} | {} | {} | {:.2}, {:.2}, {:.2} |",
+                last.normalised_dcd,
+                last.dcd,
+                last.volume_difference,
+                last.elements,
+                score.expert_elements,
+                r.p10,
+                r.median,
+                r.p90
             );
         }
         let n = scores.len().max(1) as f64;
@@ -203,7 +222,7 @@ impl Run<'_> {
         if let Some(step) = summary.steps.last() {
             let _ = writeln!(
                 md,
-                "| **mean** | **{:.3}** | **{:.4}** | **{volume:.3e}** | **{:.0}** | **{:.0}** |",
+                "| **mean** | **{:.3}** | **{:.4}** | **{volume:.3e}** | **{:.0}** | **{:.0}** | |",
                 step.normalised_dcd, step.dcd, step.elements, summary.expert_elements
             );
         }

@@ -8,6 +8,7 @@ use amber_experiments::{ModelCard, Task, resolve_model};
 use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, MeshData, read_any_mesh, read_mesh, read_mesh_with_data, write_mesh};
 use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
+use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
 use amber_tasks::cad::is_cad;
 use amber_tasks::part::{
@@ -181,7 +182,13 @@ where
         write_steps(dir, &generated)?;
     }
     let last = &generated.last().expect("at least one step").mesh;
-    write_output(last, &args.output)?;
+    // Where the final mesh is coarser (> 0) or finer than the expert's, for a viewer.
+    let log_ratios = scored.as_ref().map(|p| log_size_ratios(last, &p.expert_mesh));
+    let cells = match &log_ratios {
+        Some(ratios) => MeshData::new().with_cell("log_size_ratio_to_expert", ratios.clone()),
+        None => MeshData::new(),
+    };
+    write_output(last, &args.output, cells)?;
     for (t, (step, metrics)) in generated.iter().zip(&metrics).enumerate() {
         let score = metrics.map_or(String::new(), |m| {
             format!(
@@ -197,6 +204,14 @@ where
             p.expert_mesh.num_elements(),
             r.initial_dcd,
             r.reconstruction_dcd
+        );
+    }
+    if let Some(ratios) = &log_ratios {
+        let s = SizeRatios::of(ratios);
+        eprintln!(
+            "final element sizes ÷ the expert's where they lie: median {:.2} (10 % below {:.2}, 10 % above {:.2}); \
+             field `log_size_ratio_to_expert` in the output",
+            s.median, s.p10, s.p90
         );
     }
     eprintln!("{steps} steps in {seconds:.2} s; wrote {}", args.output.display());
@@ -269,7 +284,7 @@ fn degenerate_elements<const D: usize>(mesh: &Mesh<D>) -> (f64, usize) {
 
 /// Writes `mesh` to `output` by extension, with its element sizes; `.png` is a picture. Says
 /// how well shaped the mesh is, with a warning when elements are nearly degenerate.
-fn write_output<const D: usize>(mesh: &Mesh<D>, output: &Path) -> anyhow::Result<()>
+fn write_output<const D: usize>(mesh: &Mesh<D>, output: &Path, cells: MeshData) -> anyhow::Result<()>
 where
     Mesh<D>: Picture,
 {
@@ -288,7 +303,7 @@ where
             let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
             mesh.picture(&sizes, &options, output)
         }
-        _ => Ok(write_mesh(mesh, output, &MeshData::new().with_cell("size", sizes))?),
+        _ => Ok(write_mesh(mesh, output, &cells.with_cell("size", sizes))?),
     }
 }
 
@@ -301,7 +316,7 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
         let surface = read_solid_surface(Path::new(geometry), args.feature_angle, h)?;
         let params = Mesh3dParams::default().with_max_elements(args.max_elements);
         let mesh = generate_3d(&surface, &ConstantSize(h), &params).context("mesh generation failed")?;
-        write_output(&mesh, &args.output)?;
+        write_output(&mesh, &args.output, MeshData::new())?;
         eprintln!(
             "{} tetrahedra in {:.3} s; wrote {}",
             mesh.num_elements(),
@@ -320,7 +335,7 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
         }
     };
     let seconds = start.elapsed().as_secs_f64();
-    write_output(&mesh, &args.output)?;
+    write_output(&mesh, &args.output, MeshData::new())?;
     eprintln!(
         "{} triangles in {seconds:.3} s; size ratio median {:.3} (p10 {:.3}, p90 {:.3}); mean smallest angle {:.1}°; wrote {}",
         mesh.num_elements(),

@@ -253,6 +253,8 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
         assert!(last["normalised_dcd"].as_f64().unwrap().is_finite(), "{part}");
         assert!(last["elements"].as_u64().unwrap() > 0 && part["evaluation"]["expert_elements"].as_u64().unwrap() > 0);
         assert!(std::fs::metadata(out.join(part["picture"].as_str().unwrap())).unwrap().len() > 1000);
+        let ratios = ["p10", "median", "p90"].map(|q| part["size_ratios"][q].as_f64().unwrap());
+        assert!(ratios[0] > 0.0 && ratios[0] <= ratios[1] && ratios[1] <= ratios[2], "{part}");
     }
     let table = std::fs::read_to_string(out.join("evaluation.md")).unwrap();
     assert!(table.contains("| test/plate00 |") && table.contains("**mean**"), "{table}");
@@ -290,11 +292,17 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
 
     let mesh = dir.path().join("plate.vtu");
     let plate = data.join("test/plate00.msh");
-    let output = amber().arg("mesh").arg(&plate).arg("--model").arg(&run).arg("-o").arg(&mesh).output().unwrap();
+    let mut command = amber();
+    command.arg("mesh").arg(&plate).arg("--model").arg(&run).arg("--expert").arg(&plate).arg("-o").arg(&mesh);
+    let output = command.output().unwrap();
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     let expert = amber_mesh::read_mesh::<2>(&plate).unwrap();
-    let generated = amber_mesh::read_mesh::<2>(&mesh).unwrap();
+    let (generated, cells) = amber_mesh::read_mesh_with_data::<2>(&mesh).unwrap();
     assert!((generated.total_volume() - expert.total_volume()).abs() < 1e-9);
+    // The final mesh carries where it is coarser or finer than the expert's.
+    let field = &cells.cell["log_size_ratio_to_expert"];
+    let expected = amber_metrics::log_size_ratios(&generated, &expert);
+    assert!(field.iter().zip(&expected).all(|(a, b)| (a - b).abs() < 1e-9) && field.len() == expected.len());
 
     // A 2D model on a folder of tet meshes is an error naming both.
     let solids = dir.path().join("solids");
