@@ -4,6 +4,8 @@
 read:  meshio and gmsh write a 2D triangle mesh and a 3D tetrahedral mesh (with a cell array
        `size`) in every format and encoding they have; `amber convert` turns each into JSON,
        which must hold the same vertices (to 1e-12), the same elements and the same `size`.
+       The same for gmsh's second-order meshes (triangle6, tetra10), which amber reads as the
+       linear simplices of their corners.
 write: `amber convert` writes a reference mesh (JSON with `size`) in every format and encoding
        it has; meshio and gmsh read each back: same vertex and element counts, same coordinates
        (to 1e-12), `size` preserved (meshio, where the format stores cell data), physical groups
@@ -204,6 +206,49 @@ def gmsh_inputs(dim, size, directory):
     return out
 
 
+QUADRATIC = {2: "triangle6", 3: "tetra10"}
+
+
+def quadratic_inputs(dim, directory):
+    """gmsh's second-order mesh of the reference model, written by gmsh and meshio in every format
+    that stores it, and the mesh of its corners (points, cells): what amber reads from each."""
+    restart_gmsh()
+    gmsh_model(dim)
+    gmsh.model.mesh.setOrder(2)
+    out = []
+    for version in ["2.2", "4.1"]:
+        for binary in [0, 1]:
+            path = os.path.join(directory, f"quadratic{dim}-{version}-{binary}.msh")
+            gmsh.option.setNumber("Mesh.MshFileVersion", float(version))
+            gmsh.option.setNumber("Mesh.Binary", binary)
+            gmsh.write(path)
+            out.append(("gmsh", "msh", f"{version} {'binary' if binary else 'ascii'}", path))
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    # gmsh's .bdf has 8-character fields: its coordinates carry 7 digits.
+    for ext in ["vtk", "mesh", "bdf"]:
+        path = os.path.join(directory, f"quadratic{dim}.{ext}")
+        gmsh.write(path)
+        out.append(("gmsh", ext if ext != "bdf" else "nas", "ascii", path))
+    m = meshio_read(out[0][3])
+    full = np.concatenate([c.data for c in m.cells if c.type == QUADRATIC[dim]])
+    corners = full[:, : dim + 1]
+    used = np.unique(corners)
+    remap = -np.ones(len(m.points), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    points = np.zeros((len(used), 3))
+    points[:, : m.points.shape[1]] = m.points[used]
+    # meshio's medit writer skips second-order cells, and its NASTRAN writer names the card
+    # `CTETRA_`, which no NASTRAN reads.
+    mesh = meshio.Mesh(m.points if dim == 3 else m.points[:, :2], [(QUADRATIC[dim], full)])
+    for fmt, name, write in [("vtu", "b.vtu", lambda p: meshio.vtu.write(p, mesh, binary=True)),
+                             ("vtk", "a.vtk", lambda p: meshio.vtk.write(p, mesh, binary=False)),
+                             ("inp", "a.inp", lambda p: meshio.write(p, mesh, file_format="abaqus"))]:
+        path = os.path.join(directory, f"meshio-quadratic{dim}-{name}")
+        write(path)
+        out.append(("meshio", fmt, "binary" if name.startswith("b") else "ascii", path))
+    return points, remap[corners], out
+
+
 def meshio_read(path):
     """meshio.read, told that .msh is gmsh (else a failure tries ANSYS and exits the process)."""
     return meshio.read(path, file_format="gmsh" if path.endswith(".msh") else None)
@@ -279,6 +324,15 @@ def main():
                     check_amber_json(out, dim, *expected[:2], expected_size if has_data else None)
 
                 record(fmt, f"{encoding} {dim}D", "read", tool, read_check)
+            quadratic_points, quadratic_cells, quadratic = quadratic_inputs(dim, directory)
+            for tool, fmt, encoding, path in quadratic:
+
+                def quadratic_check(path=path):
+                    amber_convert(path, path + ".json")
+                    tol = 1e-6 if path.endswith(".bdf") else TOL
+                    check_amber_json(path + ".json", dim, quadratic_points, quadratic_cells, None, tol)
+
+                record(fmt, f"{encoding} {dim}D {QUADRATIC[dim]}", "read", tool, quadratic_check)
             outputs = [("vtu", "binary", ["--binary"]), ("vtu", "ascii", ["--ascii"]), ("vtk", "ascii", []),
                        ("vtk", "binary", ["--binary"]), ("msh", "ascii", []), ("msh", "binary", ["--binary"]),
                        ("nas", "ascii", []), ("inp", "ascii", []), ("mesh", "ascii", [])]

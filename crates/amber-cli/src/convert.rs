@@ -57,6 +57,10 @@ fn write<const D: usize>(
         data.point.len(),
         data.facet_tags.len()
     );
+    if !data.linearised.is_empty() {
+        let linearised: Vec<String> = data.linearised.iter().map(|(kind, n)| format!("{n} {kind}")).collect();
+        summary += &format!("; read by their corner nodes: {}", linearised.join(", "));
+    }
     if !data.dropped.is_empty() {
         let dropped: Vec<String> = data.dropped.iter().map(|(kind, n)| format!("{n} {kind}")).collect();
         summary += &format!("; not meshed elements dropped: {}", dropped.join(", "));

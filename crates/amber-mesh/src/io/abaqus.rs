@@ -1,7 +1,8 @@
 //! Abaqus input (`.inp`): `*NODE` and `*ELEMENT, TYPE=...` blocks (data lines continue while
 //! they end with a comma; keywords are case-insensitive; `**` starts a comment; every other
 //! keyword's data is skipped). Element types are classified by their family prefix and node
-//! count (`C3D4` tetrahedron, `CPS3`/`CPE3`/`S3`/... triangle, `C3D10` dropped as `tetra10`, ...).
+//! count (`C3D4` tetrahedron, `CPS3`/`CPE3`/`S3`/... triangle, `C3D10` and `CPS6`/... read by their
+//! corners, ...).
 //! The writer writes `*NODE` and one `*ELEMENT` block, `C3D4` or `CPS3`, in ELSET `domain`.
 
 use std::collections::HashMap;
@@ -44,14 +45,14 @@ fn element_kind(ty: &str) -> Option<Kind> {
         (1, _) => other("line_element"),
         (2, 3) => Some(Kind::TRIANGLE),
         (2, 4) => other("quad"),
-        (2, 6) => other("triangle6"),
+        (2, 6) => Some(Kind::TRIANGLE6),
         (2, 8) => other("quad8"),
         (2, _) => other("surface_element"),
         (_, 4) => Some(Kind::TETRA),
         (_, 5) => other("pyramid"),
         (_, 6) => other("wedge"),
         (_, 8) => other("hexahedron"),
-        (_, 10) => other("tetra10"),
+        (_, 10) => Some(Kind::TETRA10),
         (_, 15) => other("wedge15"),
         (_, 20) => other("hexahedron20"),
         _ => other("solid_element"),

@@ -4,8 +4,9 @@
 //! both; and reading triangle surfaces, `.stl` (binary or ASCII) and `.obj`, as the plain
 //! triangles the file lists ([`TriangleSoup`]).
 //!
-//! Every mesh reader keeps only the linear simplices of the mesh dimension (and says in
-//! [`MeshData::dropped`] what else the file held), drops vertices no kept element uses (a stray
+//! Every mesh reader keeps only the simplices of the mesh dimension, quadratic ones (`tetra10`,
+//! `triangle6`) as the linear simplices of their corner nodes (and says in
+//! [`MeshData::linearised`] and [`MeshData::dropped`] what the file held beside linear ones), drops vertices no kept element uses (a stray
 //! vertex would make an FEM system singular) and flips negatively oriented elements. Surfaces
 //! are read as they are: welding and checking them is the mesher's job. Every writer writes to a
 //! temporary file beside the target, fsyncs it and renames it (amber-stdx's
@@ -45,9 +46,13 @@ pub struct MeshData {
     /// physical group per tag (tags must be positive); without tags it writes one group for the
     /// whole boundary.
     pub facet_tags: BTreeMap<Vec<u32>, i32>,
-    /// Elements a reader dropped because they are not linear simplices of the mesh dimension,
-    /// counted by kind (`line`, `quad`, `triangle6`, ...). Writers ignore it.
+    /// Elements a reader dropped because they are not simplices of the mesh dimension, counted
+    /// by kind (`line`, `quad`, `hexahedron`, ...). Writers ignore it.
     pub dropped: BTreeMap<String, usize>,
+    /// Quadratic simplices of the mesh dimension (`tetra10`, `triangle6`) a reader kept as the
+    /// linear simplices of their corners, their edge nodes dropped, counted by kind. Writers
+    /// ignore it.
+    pub linearised: BTreeMap<String, usize>,
 }
 
 impl MeshData {

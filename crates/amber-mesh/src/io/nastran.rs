@@ -1,7 +1,8 @@
 //! NASTRAN bulk data (`.nas`, `.bdf`): GRID points (small fixed-field, free-field, and
-//! large-field `GRID*` with its `*` continuation line), 4-node CTETRA and 3-node CTRIA3 elements;
-//! other element cards (CQUAD4, CHEXA, CPENTA, CPYRAM, CBAR, CBEAM, CROD, 10-node CTETRA) are
-//! counted as dropped and every other card is skipped. Reading stops at ENDDATA, which must be
+//! large-field `GRID*` with its `*` continuation line), CTETRA and CTRIA3 elements, and 10-node
+//! CTETRA and CTRIA6 by their corner grids (the edge grids, some on continuation lines, are not
+//! needed); other element cards (CQUAD4, CHEXA, CPENTA, CPYRAM, CBAR, CBEAM, CROD) are counted as
+//! dropped and every other card is skipped. Reading stops at ENDDATA, which must be
 //! there: a file without it is truncated, and a partial mesh is never returned. Reals may use
 //! NASTRAN's implicit exponent (`-7.11-15` = -7.11e-15). GRID ids may have gaps.
 //!
@@ -16,12 +17,13 @@ use super::raw::{Kind, RawMesh};
 use super::{Lines, MeshError};
 use crate::Mesh;
 
-/// The kind of an element card, and whether its grid ids are read (only the linear simplices).
+/// The kind of an element card (a CTETRA with edge grids is found by its fields).
 fn element_card(card: &str) -> Option<Kind> {
     let other = |dim, name| Some(Kind { dim, name });
     match card {
         "CTETRA" => Some(Kind::TETRA),
         "CTRIA3" => Some(Kind::TRIANGLE),
+        "CTRIA6" => Some(Kind::TRIANGLE6),
         "CQUAD4" => other(2, "quad"),
         "CHEXA" => other(3, "hexahedron"),
         "CPENTA" => other(3, "wedge"),
@@ -71,16 +73,17 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                 }
                 raw.points.push([x, y, z]);
             }
-            "CTETRA" if !fields.get(7).is_empty() || !fields.get(8).is_empty() => {
-                elements.push((Kind { dim: 3, name: "tetra10" }, Vec::new(), lines.line))
-            }
             "ENDDATA" => {
                 complete = true;
                 break;
             }
             card => {
-                if let Some(kind) = element_card(card) {
-                    let ids = if kind == Kind::TETRA || kind == Kind::TRIANGLE {
+                if let Some(mut kind) = element_card(card) {
+                    if kind == Kind::TETRA && !(fields.get(7).is_empty() && fields.get(8).is_empty()) {
+                        kind = Kind::TETRA10;
+                    }
+                    // The simplices' corner grids; the other cards are only counted.
+                    let ids = if [Kind::TETRA, Kind::TRIANGLE, Kind::TETRA10, Kind::TRIANGLE6].contains(&kind) {
                         (0..=kind.dim)
                             .map(|k| lines.parse(Some(fields.get(3 + k)), &format!("{card} grid id")))
                             .collect::<Result<Vec<u64>, _>>()?
@@ -264,11 +267,13 @@ GRID          99            junk\r\n";
     fn reads_large_field_grids_and_writes_what_it_reads() {
         let text = "GRID*                  1               0             0.0             0.0\n\
 *                    0.0\nGRID*                  2               0             1.0            0.0\n*       -0.5\n\
-GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA,2,1,1,2,3,4,5,6,7,8,9,10\nCQUAD4,3,1,1,2,3,4\nENDDATA\n";
+GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nGRID,5,,1.,1.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA,2,1,2,3,4,5,6,7,8,9,10,11\nCQUAD4,3,1,1,2,3,4\nENDDATA\n";
         let path = Path::new("large.nas");
         let (mesh, data) = read(path, text.as_bytes()).unwrap().finish::<3>(path).unwrap();
         assert_eq!(mesh.vertices()[1], [1.0, 0.0, -0.5]);
-        assert_eq!(data.dropped, std::collections::BTreeMap::from([("quad".into(), 1), ("tetra10".into(), 1)]));
+        assert_eq!(mesh.num_elements(), 2, "the 10-node CTETRA by its corners");
+        assert_eq!(data.dropped, std::collections::BTreeMap::from([("quad".into(), 1)]));
+        assert_eq!(data.linearised, std::collections::BTreeMap::from([("tetra10".into(), 1)]));
         let square = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0 / 3.0, 1.0]], vec![0, 1, 2]).unwrap();
         let mut bytes = Vec::new();
         write(&square, &mut bytes).unwrap();

@@ -1,7 +1,8 @@
 //! What every mixed-element reader (`.msh`, `.vtu`, `.vtk`, `.nas`, `.inp`, `.mesh`) produces
 //! before a mesh is built: points in 3D and cells of any kind in file order. [`RawMesh::finish`]
-//! is the one place that decides the dimension, keeps the simplices of it, turns tagged facets
-//! into [`MeshData::facet_tags`] and counts what it dropped.
+//! is the one place that decides the dimension, keeps the simplices of it (quadratic ones by
+//! their corner nodes), turns tagged facets into [`MeshData::facet_tags`] and counts what it
+//! dropped.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -21,14 +22,41 @@ impl Kind {
     pub(super) const LINE: Kind = Kind { dim: 1, name: "line" };
     pub(super) const TRIANGLE: Kind = Kind { dim: 2, name: "triangle" };
     pub(super) const TETRA: Kind = Kind { dim: 3, name: "tetra" };
+    pub(super) const LINE3: Kind = Kind { dim: 1, name: "line3" };
+    pub(super) const TRIANGLE6: Kind = Kind { dim: 2, name: "triangle6" };
+    pub(super) const TETRA10: Kind = Kind { dim: 3, name: "tetra10" };
 
     /// The linear simplex of dimension `dim` (0 to 3).
     pub(super) fn simplex(dim: usize) -> Kind {
         [Self::VERTEX, Self::LINE, Self::TRIANGLE, Self::TETRA][dim]
     }
 
+    /// The quadratic simplex of dimension `dim` (1 to 3): corner nodes first, then one node per
+    /// edge, in every format amber reads.
+    fn quadratic(dim: usize) -> Option<Kind> {
+        [None, Some(Self::LINE3), Some(Self::TRIANGLE6), Some(Self::TETRA10)].get(dim).copied().flatten()
+    }
+
     fn is_simplex(self) -> bool {
         self == Self::simplex(self.dim)
+    }
+
+    fn is_quadratic(self) -> bool {
+        Self::quadratic(self.dim) == Some(self)
+    }
+
+    /// The nodes a cell of this kind may list: a linear simplex its corners; a quadratic one its
+    /// corners and edge nodes, or its corners alone (NASTRAN's edge grids sit on continuation
+    /// lines, which the reader does not need); `None` for any other kind.
+    fn node_counts(self) -> Option<[usize; 2]> {
+        let corners = self.dim + 1;
+        if self.is_simplex() {
+            Some([corners; 2])
+        } else if self.is_quadratic() {
+            Some([corners, corners * (corners + 1) / 2])
+        } else {
+            None
+        }
     }
 }
 
@@ -65,8 +93,9 @@ impl RawMesh {
     }
 
     /// Builds the `D`-dimensional mesh: fails with [`MeshError::DimensionMismatch`] when the
-    /// highest cell dimension is not `D` (so a caller can try the other), keeps the linear
-    /// `D`-simplices with their cell data, records tagged `(D-1)`-simplices as facet tags and
+    /// highest cell dimension is not `D` (so a caller can try the other), keeps the
+    /// `D`-simplices with their cell data (a quadratic one as the linear simplex of its corners,
+    /// counted in [`MeshData::linearised`]), records tagged `(D-1)`-simplices as facet tags and
     /// counts every other cell in [`MeshData::dropped`].
     pub(super) fn finish<const D: usize>(self, path: &Path) -> Result<(Mesh<D>, MeshData), MeshError> {
         let found = self.dimension();
@@ -87,18 +116,25 @@ impl RawMesh {
         let mut cells = Vec::new();
         for (i, &kind) in self.kinds.iter().enumerate() {
             let nodes = self.cell(i);
-            if nodes.len() != kind.dim + 1 && kind.is_simplex() {
+            if let Some(counts) = kind.node_counts()
+                && !counts.contains(&nodes.len())
+            {
                 return Err(format_error(format!("cell {i} is a {} with {} nodes", kind.name, nodes.len())));
             }
-            if kind == Kind::simplex(D) {
+            // Corner nodes come first in a quadratic simplex.
+            let corners = &nodes[..nodes.len().min(kind.dim + 1)];
+            if kind.dim == D && kind.node_counts().is_some() {
                 kept.push(i);
-                cells.extend_from_slice(nodes);
+                cells.extend_from_slice(corners);
+                if kind.is_quadratic() {
+                    *data.linearised.entry(kind.name.to_owned()).or_default() += 1;
+                }
                 continue;
             }
             *data.dropped.entry(kind.name.to_owned()).or_default() += 1;
             let tag = self.tags.get(i).copied().unwrap_or(0);
-            if kind == Kind::simplex(D - 1) && tag != 0 {
-                let mut facet = nodes.to_vec();
+            if kind.dim + 1 == D && kind.node_counts().is_some() && tag != 0 {
+                let mut facet = corners.to_vec();
                 facet.sort_unstable();
                 data.facet_tags.insert(facet, tag);
             }
@@ -145,5 +181,31 @@ mod tests {
         let raw = RawMesh { points: vec![[0.0; 3]], kinds: vec![Kind::LINE], ..Default::default() };
         let err = raw.finish::<2>(Path::new("x")).unwrap_err();
         assert!(matches!(err, MeshError::DimensionMismatch { found: 1, .. }), "{err}");
+    }
+
+    /// A quadratic triangle is the linear triangle of its corners (its edge nodes dropped with
+    /// the vertices nothing else uses, the rest renumbered), a tagged quadratic edge tags the
+    /// facet of its ends, and a
+    /// quadratic simplex with a node count of neither kind is an error.
+    #[test]
+    fn keeps_quadratic_simplices_by_their_corners() {
+        let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let edges = [[0.5, 0.0, 0.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.0]];
+        // An edge node first, so that dropping it renumbers the corners.
+        let points = [edges[0]].iter().chain(&corners).chain(&edges[1..]).copied().collect();
+        let mut raw = RawMesh { points, ..Default::default() };
+        raw.push_cell(Kind::TRIANGLE6, [1, 2, 3, 0, 4, 5]);
+        raw.push_cell(Kind::LINE3, [1, 2, 0]);
+        raw.tags = vec![1, 4];
+        let (mesh, data) = raw.finish::<2>(Path::new("x")).unwrap();
+        assert_eq!(mesh.vertices(), &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        assert_eq!(mesh.cells(), &[0, 1, 2]);
+        assert_eq!(data.linearised, BTreeMap::from([("triangle6".into(), 1)]));
+        assert_eq!(data.dropped, BTreeMap::from([("line3".into(), 1)]));
+        assert_eq!(data.facet_tags, BTreeMap::from([(vec![0, 1], 4)]));
+        let mut raw = RawMesh { points: corners.to_vec(), ..Default::default() };
+        raw.push_cell(Kind::TRIANGLE6, [0, 1, 2, 0]);
+        let err = raw.finish::<2>(Path::new("x")).unwrap_err().to_string();
+        assert!(err.contains("triangle6 with 4 nodes"), "{err}");
     }
 }
