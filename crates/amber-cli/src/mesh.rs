@@ -6,13 +6,13 @@ use std::time::Instant;
 
 use amber_experiments::{ModelCard, Task, resolve_model};
 use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, MeshData, read_any_mesh, read_mesh, read_mesh_with_data, write_mesh};
-use amber_meshgen::mesh3d::{Mesh3dParams, generate_3d};
+use amber_meshgen::mesh3d::{Mesh3dParams, SurfaceDistance, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
 use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
 use amber_tasks::cad::is_cad;
 use amber_tasks::part::{
-    FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, read_polygon_domain, read_solid_surface,
+    FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, cad_face_tags, read_polygon_domain, read_solid_surface,
 };
 use amber_tasks::poisson::{PoissonPart, read_part};
 use amber_tasks::{Domain, WithExpert};
@@ -169,6 +169,9 @@ where
         e => e.into(),
     })?;
     let seconds = start.elapsed().as_secs_f64();
+    let last = &generated.last().expect("at least one step").mesh;
+    // The boundary grouped by CAD face, for a solver's boundary conditions.
+    let facet_tags = domain.boundary_tags(last);
     let scored = expert.map(|(mesh, path)| WithExpert::new(domain, mesh, &path)).transpose()?;
     let reference = scored.as_ref().map(|p| Reference::new(p, model.limits())).transpose()?;
     let metrics: Vec<Option<MeshMetrics>> = generated
@@ -181,13 +184,12 @@ where
     if let Some(dir) = &args.every_step {
         write_steps(dir, &generated)?;
     }
-    let last = &generated.last().expect("at least one step").mesh;
     // Where the final mesh is coarser (> 0) or finer than the expert's, for a viewer.
     let log_ratios = scored.as_ref().map(|p| log_size_ratios(last, &p.expert_mesh));
-    let cells = match &log_ratios {
-        Some(ratios) => MeshData::new().with_cell("log_size_ratio_to_expert", ratios.clone()),
-        None => MeshData::new(),
-    };
+    let mut cells = MeshData { facet_tags, ..MeshData::new() };
+    if let Some(ratios) = &log_ratios {
+        cells = cells.with_cell("log_size_ratio_to_expert", ratios.clone());
+    }
     write_output(last, &args.output, cells)?;
     for (t, (step, metrics)) in generated.iter().zip(&metrics).enumerate() {
         let score = metrics.map_or(String::new(), |m| {
@@ -316,7 +318,8 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
         let surface = read_solid_surface(Path::new(geometry), args.feature_angle, h)?;
         let params = Mesh3dParams::default().with_max_elements(args.max_elements);
         let mesh = generate_3d(&surface, &ConstantSize(h), &params).context("mesh generation failed")?;
-        write_output(&mesh, &args.output, MeshData::new())?;
+        let facet_tags = cad_face_tags(&SurfaceDistance::new(&surface), &mesh);
+        write_output(&mesh, &args.output, MeshData { facet_tags, ..MeshData::new() })?;
         eprintln!(
             "{} tetrahedra in {:.3} s; wrote {}",
             mesh.num_elements(),

@@ -419,7 +419,8 @@ fn every_shipped_model_meshes_a_geometry_of_its_task() {
 }
 
 /// A STEP file is a geometry like its gmsh-made reference surface: `amber mesh part.step`
-/// tessellates it through gmsh and fills it. Reads `../shared/`; needs gmsh.
+/// tessellates it through gmsh and fills it, and the `.msh` groups the boundary by CAD face.
+/// Reads `../shared/`; needs gmsh.
 #[test]
 fn meshes_a_step_file_through_gmsh() {
     let Some(data) = amber_testdata::shared("data/console") else { return };
@@ -438,6 +439,15 @@ fn meshes_a_step_file_through_gmsh() {
     .unwrap()
     .0
     .enclosed_volume();
-    let total = amber_mesh::read_mesh::<3>(&out).unwrap().total_volume();
+    let (mesh, written) = amber_mesh::read_mesh_with_data::<3>(&out).unwrap();
+    let total = mesh.total_volume();
     assert!((total / reference - 1.0).abs() < 5e-3, "volume {total} for {reference}");
+    // One physical group per CAD face, over the whole boundary.
+    let info: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(data.join("reference_surface/val/002.json")).unwrap()).unwrap();
+    let faces = info["faces"].as_array().unwrap().len();
+    let groups: std::collections::BTreeSet<i32> = written.facet_tags.values().copied().collect();
+    assert_eq!(groups.len(), faces, "{groups:?}");
+    let boundary = amber_mesh::FacetAdjacency::new(&mesh).unwrap().boundary_facets().count();
+    assert_eq!(written.facet_tags.len(), boundary);
 }

@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use amber_graph::FeatureSet;
-use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, StlFaceIds, read_any_mesh, read_surface};
+use amber_mesh::{AnyMesh, FacetAdjacency, Mesh, Mesh2, Mesh3, StlFaceIds, read_any_mesh, read_surface};
 use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, Surface, SurfaceDistance, generate_3d};
 use amber_meshgen::{
     ConstantSize, Mesh2dParams, MeshSizing, MeshgenError, PolygonDistance, PolygonDomain, generate_2d, uniform_mesh_2d,
@@ -275,6 +275,27 @@ impl Domain<3> for SolidPart {
         generate_3d(&self.surface, &MeshSizing::new(mesh, sizes), &params)
             .map_err(|e| ProblemError::Meshing(MeshgenError::from(e)))
     }
+
+    fn boundary_tags(&self, mesh: &Mesh<3>) -> BTreeMap<Vec<u32>, i32> {
+        cad_face_tags(&self.distance, mesh)
+    }
+}
+
+/// Every boundary triangle of `mesh` (a mesh of the solid `distance` measures), keyed by its
+/// sorted vertices, tagged with the CAD face nearest its centroid: the generator keeps every
+/// surface vertex on its own face and every triangle within one face, so this is the face it
+/// was made on. Empty for a mesh whose facets do not pair up (not a generated mesh).
+pub fn cad_face_tags(distance: &SurfaceDistance, mesh: &Mesh3) -> BTreeMap<Vec<u32>, i32> {
+    let Ok(adjacency) = FacetAdjacency::new(mesh) else { return BTreeMap::new() };
+    let vertices = mesh.vertices();
+    (adjacency.oriented_boundary_facets(mesh).par_iter())
+        .filter_map(|facet| {
+            let centroid = amber_mesh::centroid::<3>(vertices, facet);
+            let mut key = facet.to_vec();
+            key.sort_unstable();
+            distance.nearest_face(centroid).map(|face| (key, face))
+        })
+        .collect()
 }
 
 /// A planar domain to mesh: its polygon with holes and M⁰, meshed by the 2D generator.
@@ -361,6 +382,28 @@ mod tests {
     use std::f64::consts::FRAC_PI_2;
 
     use super::*;
+
+    /// A cube of six CAD faces, meshed: every boundary triangle is tagged with the face it lies
+    /// on (the coordinate that is 0 or 1 across its corners says which).
+    #[test]
+    fn boundary_triangles_are_tagged_with_their_cad_face() {
+        let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
+        let sides = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let triangles = sides.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+        let faces = (1..=6).flat_map(|f| [f; 2]).collect();
+        let part = SolidPart::new("cube".into(), Surface::new(v, triangles, faces).unwrap(), 0.3).unwrap();
+        let mesh = &part.initial_mesh;
+        let tags = part.boundary_tags(mesh);
+        assert_eq!(tags.len(), FacetAdjacency::new(mesh).unwrap().boundary_facets().count());
+        // Side k of `sides` is z = 0, z = 1, y = 0, y = 1, x = 0, x = 1.
+        let plane =
+            |face: i32| ([2, 2, 1, 1, 0, 0][face as usize - 1], [0.0, 1.0, 0.0, 1.0, 0.0, 1.0][face as usize - 1]);
+        for (facet, &face) in &tags {
+            let (axis, value) = plane(face);
+            assert!(facet.iter().all(|&i| mesh.vertices()[i as usize][axis] == value), "{facet:?} on face {face}");
+        }
+        assert_eq!(tags.values().copied().collect::<std::collections::BTreeSet<_>>().len(), 6);
+    }
 
     /// Every element of an L-shaped plate gets the geometry inputs, no element is farther from
     /// the boundary than from the nearest corner, and the element nearest to the re-entrant

@@ -7,6 +7,7 @@
 //! requested element count ([`mesh_to_element_count`]). Each task implements the traits beside
 //! its data (`poisson`, `console`); geometry-only domains live in `part`.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use amber_fem::FemError;
@@ -64,6 +65,13 @@ pub trait Domain<const D: usize>: Sync {
     /// A new mesh of the domain whose element sizes follow the piecewise-constant field `sizes`
     /// on `mesh`; the generator refuses to build more than `max_elements` elements.
     fn remesh(&self, mesh: &Mesh<D>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<D>, ProblemError>;
+    /// The boundary facets of `mesh` (a mesh of this domain), keyed by their sorted vertices,
+    /// each tagged with the piece of the domain's boundary it lies on (a solid's CAD faces), for
+    /// the writers that group the boundary (gmsh physical groups, medit references); empty where
+    /// the boundary is one piece.
+    fn boundary_tags(&self, _mesh: &Mesh<D>) -> BTreeMap<Vec<u32>, i32> {
+        BTreeMap::new()
+    }
 }
 
 /// One problem of a learning task in `D` dimensions: a domain with the expert's mesh of it.
@@ -114,6 +122,10 @@ impl<const D: usize, P: Domain<D>> Domain<D> for WithExpert<P, D> {
 
     fn remesh(&self, mesh: &Mesh<D>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<D>, ProblemError> {
         self.domain.remesh(mesh, sizes, max_elements)
+    }
+
+    fn boundary_tags(&self, mesh: &Mesh<D>) -> BTreeMap<Vec<u32>, i32> {
+        self.domain.boundary_tags(mesh)
     }
 }
 

@@ -13,8 +13,8 @@ use crate::ray::{chord, ray_triangle};
 #[derive(Clone, Debug)]
 pub struct SurfaceDistance {
     /// Every triangle with the surface's radius of curvature there (see
-    /// [`SurfaceDistance::to_surface`]).
-    triangles: RTree<GeomWithData<RefTriangle, f64>>,
+    /// [`SurfaceDistance::to_surface`]) and its CAD face.
+    triangles: RTree<GeomWithData<RefTriangle, (f64, i32)>>,
     /// The edges between two different CAD faces, each with the angle between its two faces'
     /// normals (0: the faces continue tangentially, π/2: a right-angled bend).
     curves: RTree<GeomWithData<Line<[f64; 3]>, f64>>,
@@ -53,8 +53,9 @@ impl SurfaceDistance {
                 curvature[l] = curvature[l].max(across);
             }
         }
-        let triangles =
-            t.iter().zip(&curvature).map(|(tri, &c)| GeomWithData::new(RefTriangle(corners(tri)), 1.0 / c)).collect();
+        let triangles = (t.iter().zip(&curvature).zip(surface.face_ids()))
+            .map(|((tri, &c), &face)| GeomWithData::new(RefTriangle(corners(tri)), (1.0 / c, face)))
+            .collect();
         Self { triangles: RTree::bulk_load(triangles), curves: RTree::bulk_load(curves) }
     }
 
@@ -62,7 +63,15 @@ impl SurfaceDistance {
     /// point nearest to `p` (the largest principal curvature's, within a CAD face): infinite on
     /// a flat face.
     pub fn to_surface(&self, p: [f64; 3]) -> (f64, f64) {
-        self.triangles.nearest_neighbor(p).map_or((f64::INFINITY, f64::INFINITY), |t| (t.distance_2(&p).sqrt(), t.data))
+        self.triangles
+            .nearest_neighbor(p)
+            .map_or((f64::INFINITY, f64::INFINITY), |t| (t.distance_2(&p).sqrt(), t.data.0))
+    }
+
+    /// The CAD face of the surface point nearest to `p`, or `None` for a surface without
+    /// triangles.
+    pub fn nearest_face(&self, p: [f64; 3]) -> Option<i32> {
+        self.triangles.nearest_neighbor(p).map(|t| t.data.1)
     }
 
     /// The distance from `p` to the nearest feature curve and the angle between the normals of
