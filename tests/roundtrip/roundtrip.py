@@ -9,7 +9,7 @@ read:  meshio and gmsh write a 2D triangle mesh and a 3D tetrahedral mesh (with 
 write: `amber convert` writes a reference mesh (JSON with `size`) in every format and encoding
        it has; meshio and gmsh read each back: same vertex and element counts, same coordinates
        (to 1e-12), `size` preserved (meshio, where the format stores cell data), physical groups
-       present (.msh).
+       present (.msh), the boundary's node set (.inp).
 
 Prints a table format x encoding x direction x tool -> pass/fail (the tool that wrote the file
 for `read`, the one that read amber's file for `write`) and exits non-zero on any failure.
@@ -266,6 +266,16 @@ def read_with_meshio(path, dim, points, cells, size, has_data, physical):
         same_values(size, np.concatenate(blocks) if blocks else None, "cell data `size`")
     if physical and not {"domain", "boundary"} <= set(m.field_data):
         raise AssertionError(f"physical names {sorted(m.field_data)}")
+    if path.endswith(".inp"):
+        # The boundary's node set: the vertices of the facets that one element alone has.
+        faces = [tuple(sorted(np.delete(c, k))) for c in np.asarray(cells).tolist() for k in range(dim + 1)]
+        counts = {}
+        for f in faces:
+            counts[f] = counts.get(f, 0) + 1
+        boundary = sorted({v for f, n in counts.items() if n == 1 for v in f})
+        if "boundary" not in m.point_sets:
+            raise AssertionError(f"node sets {sorted(m.point_sets)}")
+        same_points(np.asarray(points)[boundary], got_points[np.asarray(m.point_sets["boundary"])])
 
 
 def restart_gmsh():

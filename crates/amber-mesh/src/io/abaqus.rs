@@ -3,15 +3,18 @@
 //! keyword's data is skipped). Element types are classified by their family prefix and node
 //! count (`C3D4` tetrahedron, `CPS3`/`CPE3`/`S3`/... triangle, `C3D10` and `CPS6`/... read by their
 //! corners, ...).
-//! The writer writes `*NODE` and one `*ELEMENT` block, `C3D4` or `CPS3`, in ELSET `domain`.
+//! The writer writes `*NODE` and one `*ELEMENT` block, `C3D4` or `CPS3`, in ELSET `domain`, and
+//! the boundary as one `*NSET` (for boundary conditions) and one element-side `*SURFACE` (for
+//! loads) per facet tag, `boundary_<tag>` (`boundary` when nothing is tagged), as the `.msh`
+//! writer groups it; tagged facets inside the mesh are left out, a surface being one-sided.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io::Write;
 use std::path::Path;
 
-use super::Lines;
 use super::raw::{Kind, RawMesh};
-use crate::{Mesh, MeshError};
+use super::{Lines, MeshData, tagged_facets, write_error};
+use crate::{FacetAdjacency, Mesh, MeshError};
 
 /// The kind of an Abaqus element type: the family prefix gives the dimension, the digits after it
 /// the node count.
@@ -139,7 +142,44 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     Ok(raw)
 }
 
-pub(super) fn write<const D: usize>(mesh: &Mesh<D>, w: &mut impl Write) -> std::io::Result<()> {
+/// Abaqus's number of the side of a `C3D4` or `CPS3` opposite each local node: `C3D4` faces are
+/// S1 = 1-2-3, S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1; `CPS3` edges S1 = 1-2, S2 = 2-3, S3 = 3-1.
+fn side_opposite<const D: usize>(local: usize) -> usize {
+    if D == 3 { [3, 4, 2, 1][local] } else { [2, 3, 1][local] }
+}
+
+pub(super) fn write<const D: usize>(
+    mesh: &Mesh<D>,
+    data: &MeshData,
+    w: &mut impl Write,
+    path: &Path,
+) -> Result<(), MeshError> {
+    let adjacency = FacetAdjacency::new(mesh)?;
+    let side_of: HashMap<Vec<u32>, (usize, usize)> = adjacency
+        .boundary_facets()
+        .map(|(e, local)| {
+            let mut facet: Vec<u32> =
+                (mesh.element(e).iter().enumerate()).filter_map(|(k, &v)| (k != local).then_some(v)).collect();
+            facet.sort_unstable();
+            (facet, (e, local))
+        })
+        .collect();
+    let mut groups: BTreeMap<i32, Vec<(usize, usize)>> = BTreeMap::new();
+    for (facet, tag) in tagged_facets(mesh, data, path)? {
+        let mut key = facet;
+        key.sort_unstable();
+        if let Some(&side) = side_of.get(&key) {
+            groups.entry(tag).or_default().push(side);
+        }
+    }
+    write_body(mesh, &groups, w).map_err(write_error(path))
+}
+
+fn write_body<const D: usize>(
+    mesh: &Mesh<D>,
+    groups: &BTreeMap<i32, Vec<(usize, usize)>>,
+    w: &mut impl Write,
+) -> std::io::Result<()> {
     writeln!(w, "*HEADING\nwritten by amber\n*NODE")?;
     for (i, p) in mesh.vertices().iter().enumerate() {
         write!(w, "{}", i + 1)?;
@@ -155,6 +195,27 @@ pub(super) fn write<const D: usize>(mesh: &Mesh<D>, w: &mut impl Write) -> std::
             write!(w, ", {}", v + 1)?;
         }
         writeln!(w)?;
+    }
+    for (tag, sides) in groups {
+        let name = if groups.len() == 1 { "boundary".to_owned() } else { format!("boundary_{tag}").replace('-', "m") };
+        let mut nodes: Vec<u32> = sides
+            .iter()
+            .flat_map(|&(e, local)| {
+                mesh.element(e).iter().enumerate().filter(move |&(k, _)| k != local).map(|(_, &v)| v)
+            })
+            .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        writeln!(w, "*NSET, NSET={name}")?;
+        // Abaqus reads at most 16 entries per data line.
+        for line in nodes.chunks(16) {
+            let ids: Vec<String> = line.iter().map(|v| (v + 1).to_string()).collect();
+            writeln!(w, "{}", ids.join(", "))?;
+        }
+        writeln!(w, "*SURFACE, TYPE=ELEMENT, NAME={name}")?;
+        for &(e, local) in sides {
+            writeln!(w, "{}, S{}", e + 1, side_opposite::<D>(local))?;
+        }
     }
     Ok(())
 }
@@ -186,7 +247,34 @@ mod tests {
     fn writes_what_it_reads() {
         let mesh = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0 / 3.0, 1.0]], vec![0, 1, 2]).unwrap();
         let mut bytes = Vec::new();
-        write(&mesh, &mut bytes).unwrap();
-        assert_eq!(parse::<2>(std::str::from_utf8(&bytes).unwrap()).unwrap().0, mesh);
+        write(&mesh, &MeshData::new(), &mut bytes, Path::new("x.inp")).unwrap();
+        let text = std::str::from_utf8(&bytes).unwrap();
+        assert_eq!(parse::<2>(text).unwrap().0, mesh);
+        assert!(
+            text.ends_with(
+                "*NSET, NSET=boundary\n1, 2, 3\n*SURFACE, TYPE=ELEMENT, NAME=boundary\n1, S2\n1, S3\n1, S1\n"
+            ),
+            "{text}"
+        );
+    }
+
+    /// A tet's four faces in three groups: each group's node set and the Abaqus side numbers of
+    /// its faces (S1 = nodes 1-2-3, S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1).
+    #[test]
+    fn writes_a_node_set_and_a_surface_per_facet_tag() {
+        let tet =
+            crate::Mesh3::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3]);
+        let data =
+            MeshData::new().with_facet_tag([0, 1, 2], 5).with_facet_tag([0, 3, 1], 7).with_facet_tag([1, 3, 2], 7);
+        let mut bytes = Vec::new();
+        write(&tet.unwrap(), &data, &mut bytes, Path::new("x.inp")).unwrap();
+        let text = std::str::from_utf8(&bytes).unwrap();
+        let groups = text.split_once("*NSET").unwrap().1;
+        assert_eq!(
+            groups,
+            ", NSET=boundary_5\n1, 2, 3\n*SURFACE, TYPE=ELEMENT, NAME=boundary_5\n1, S1\n\
+             *NSET, NSET=boundary_7\n1, 2, 3, 4\n*SURFACE, TYPE=ELEMENT, NAME=boundary_7\n1, S3\n1, S2\n\
+             *NSET, NSET=boundary_8\n1, 3, 4\n*SURFACE, TYPE=ELEMENT, NAME=boundary_8\n1, S4\n"
+        );
     }
 }

@@ -348,7 +348,7 @@ pub fn write_mesh_as<const D: usize>(
         Format::Msh => write_atomic(path, |w| msh::write(mesh, data, binary, w, path)),
         Format::Json => write_atomic(path, |w| json::write(mesh, data, w, path)),
         Format::Nastran => write_atomic(path, |w| nastran::write(mesh, w).map_err(write_error(path))),
-        Format::Abaqus => write_atomic(path, |w| abaqus::write(mesh, w).map_err(write_error(path))),
+        Format::Abaqus => write_atomic(path, |w| abaqus::write(mesh, data, w, path)),
         Format::Medit => write_atomic(path, |w| medit::write(mesh, data, w, path)),
     }
 }
