@@ -186,11 +186,11 @@ where
     }
     // Where the final mesh is coarser (> 0) or finer than the expert's, for a viewer.
     let log_ratios = scored.as_ref().map(|p| log_size_ratios(last, &p.expert_mesh));
-    let mut cells = MeshData { facet_tags, ..MeshData::new() };
+    let mut data = MeshData { facet_tags, ..MeshData::new() };
     if let Some(ratios) = &log_ratios {
-        cells = cells.with_cell("log_size_ratio_to_expert", ratios.clone());
+        data = data.with_cell("log_size_ratio_to_expert", ratios.clone());
     }
-    write_output(last, &args.output, cells)?;
+    write_output(last, &args.output, data)?;
     for (t, (step, metrics)) in generated.iter().zip(&metrics).enumerate() {
         let score = metrics.map_or(String::new(), |m| {
             format!(
@@ -284,9 +284,10 @@ fn degenerate_elements<const D: usize>(mesh: &Mesh<D>) -> (f64, usize) {
     (smallest, angles.iter().filter(|&&a| a < DEGENERATE_ANGLE_DEGREES).count())
 }
 
-/// Writes `mesh` to `output` by extension, with its element sizes; `.png` is a picture. Says
-/// how well shaped the mesh is, with a warning when elements are nearly degenerate.
-fn write_output<const D: usize>(mesh: &Mesh<D>, output: &Path, cells: MeshData) -> anyhow::Result<()>
+/// Writes `mesh` to `output` by extension, with its element sizes added to `data` (fields and
+/// facet tags); `.png` is a picture. Says how well shaped the mesh is, with a warning when
+/// elements are nearly degenerate.
+fn write_output<const D: usize>(mesh: &Mesh<D>, output: &Path, data: MeshData) -> anyhow::Result<()>
 where
     Mesh<D>: Picture,
 {
@@ -305,7 +306,7 @@ where
             let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
             mesh.picture(&sizes, &options, output)
         }
-        _ => Ok(write_mesh(mesh, output, &cells.with_cell("size", sizes))?),
+        _ => Ok(write_mesh(mesh, output, &data.with_cell("size", sizes))?),
     }
 }
 

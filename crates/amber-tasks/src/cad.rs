@@ -60,8 +60,8 @@ impl Gmsh {
 
     /// The surface of the CAD file `path`: gmsh's tessellation with triangles at most
     /// `max_size` long on flat faces (finer on curved ones), one face id per CAD face, corners
-    /// rounded to `f32`. Errors
-    /// name the file: gmsh absent, failing or stuck, or a file from which it made no surface.
+    /// rounded to `f32`. Errors name the file: gmsh absent, failing or stuck, or a file from
+    /// which it made no surface.
     pub fn tessellate(&self, path: &Path, max_size: f64) -> Result<TriangleSoup, TaskError> {
         let geometry = |message: String| TaskError::Geometry { path: path.into(), message };
         if !(max_size.is_finite() && max_size > 0.0) {
@@ -115,15 +115,20 @@ impl Gmsh {
     }
 }
 
-/// gmsh's error lines from its log, without terminal colours, each on a line of its own after
-/// the message (empty when there are none).
+/// gmsh's first error lines from its log, without terminal colours, each on a line of its own
+/// after the message (empty when there are none).
 fn errors_of(log: &str) -> String {
     log.lines()
         .map(strip_colours)
         .filter(|line| line.contains("Error") || line.contains("ERR"))
+        .take(ERROR_LINES)
         .map(|line| format!("\n  {}", line.trim()))
         .collect()
 }
+
+/// The error lines of gmsh's log an error message quotes: the first say what went wrong, and a
+/// broken file can make thousands.
+const ERROR_LINES: usize = 8;
 
 fn strip_colours(line: &str) -> String {
     let mut out = String::with_capacity(line.len());

@@ -185,8 +185,7 @@ mod tests {
 
     /// A quadratic triangle is the linear triangle of its corners (its edge nodes dropped with
     /// the vertices nothing else uses, the rest renumbered), a tagged quadratic edge tags the
-    /// facet of its ends, and a
-    /// quadratic simplex with a node count of neither kind is an error.
+    /// facet of its ends, and a quadratic simplex with a node count of neither kind is an error.
     #[test]
     fn keeps_quadratic_simplices_by_their_corners() {
         let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
