@@ -10,13 +10,14 @@ use amber_meshgen::mesh3d::{Mesh3dParams, SurfaceDistance, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
 use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
+use amber_stdx::quantile;
 use amber_tasks::cad::is_cad;
 use amber_tasks::part::{
     FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, cad_face_tags, read_polygon_domain, read_solid_surface,
 };
 use amber_tasks::poisson::{PoissonPart, read_part};
-use amber_tasks::{Domain, WithExpert};
-use amber_train::{ElementTarget, GeneratedStep, MeshMetrics, Reference, TrainError, TrainedModel};
+use amber_tasks::{Domain, SizeBounds, WithExpert};
+use amber_train::{ElementTarget, FinalStep, GeneratedStep, MeshMetrics, Reference, TrainError, TrainedModel};
 use anyhow::{Context, bail};
 use clap::Args;
 
@@ -47,6 +48,14 @@ pub struct MeshArgs {
     /// keeps its shape and is scaled by one factor.
     #[arg(long)]
     elements: Option<usize>,
+    /// Hold the final step's sizing field at or above this size (in the geometry's units), e.g.
+    /// for an explicit solver's time step. The field bounds the elements as it sizes them: they
+    /// scatter around it, and are smaller where the geometry's curvature or thin walls ask.
+    #[arg(long, requires = "model")]
+    min_size: Option<f64>,
+    /// Hold the final step's sizing field at or below this size.
+    #[arg(long, requires = "model")]
+    max_size: Option<f64>,
     /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,
     /// and its domain when no geometry is given; its expert mesh, when present, is the default
     /// --expert), or a part's inputs (`<stem>.inputs.json`: named numbers and points) for a model
@@ -164,7 +173,9 @@ where
 {
     let start = Instant::now();
     let target = args.elements.map(|elements| ElementTarget { elements, max_elements: args.max_elements });
-    let generated = model.generate(&domain, steps, target).map_err(|e| match e {
+    let bounds =
+        SizeBounds::new(args.min_size, args.max_size).map_err(|e| anyhow::anyhow!("--min-size/--max-size: {e}"))?;
+    let generated = model.generate(&domain, steps, FinalStep { target, bounds }).map_err(|e| match e {
         TrainError::MissingInputs(_) => anyhow::anyhow!("{e}: give the part's inputs with --problem FILE.inputs.json"),
         e => e.into(),
     })?;
@@ -293,14 +304,23 @@ where
 {
     let (smallest, degenerate) = degenerate_elements(mesh);
     let angle = if D == 2 { "angle" } else { "dihedral angle" };
-    eprintln!("smallest {angle} {smallest:.1}°");
+    let sizes = mesh.sizes();
+    let mut sorted = sizes.clone();
+    sorted.sort_by(f64::total_cmp);
+    let at = |q| quantile(&sorted, q);
+    eprintln!(
+        "element sizes from {:.4} (1 % below {:.4}) to {:.4}, median {:.4}; smallest {angle} {smallest:.1}°",
+        at(0.0),
+        at(0.01),
+        at(1.0),
+        at(0.5)
+    );
     if degenerate > 0 {
         eprintln!(
             "warning: {degenerate} of {} elements have an {angle} below {DEGENERATE_ANGLE_DEGREES}° (nearly degenerate)",
             mesh.num_elements()
         );
     }
-    let sizes = mesh.sizes();
     match output.extension().and_then(|e| e.to_str()) {
         Some("png") => {
             let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };

@@ -184,6 +184,32 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
         assert!((mesh.total_volume() - 0.96).abs() < 1e-9);
     }
 
+    // The size range: a range of one size makes the model's field uniform; an empty range is an
+    // error naming the flags.
+    for (bounds, ok) in [(["0.05", "0.05"], true), (["0.05", "0.01"], false)] {
+        let output = amber()
+            .arg("mesh")
+            .arg(&square)
+            .args(["--steps", "2", "--min-size", bounds[0], "--max-size", bounds[1], "--model"])
+            .arg(&run)
+            .arg("--problem")
+            .arg(&problem_file)
+            .arg("-o")
+            .arg(&final_mesh)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.success(), ok, "{bounds:?}: {stderr}");
+        if !ok {
+            assert!(stderr.contains("--min-size") && !stderr.contains("panicked"), "{stderr}");
+            continue;
+        }
+        let mut sizes = amber_mesh::read_mesh::<2>(&final_mesh).unwrap().sizes();
+        sizes.sort_by(f64::total_cmp);
+        let (low, high) = (sizes[sizes.len() / 20], sizes[sizes.len() * 19 / 20]);
+        assert!(low > 0.04 && high < 0.06, "5 % and 95 % of sizes {low}, {high} for a field of 0.05");
+    }
+
     // A missing model, or a Poisson model without its load, is an error with a message.
     for args in [vec!["--model", "/nonexistent", "--problem"], vec!["square", "--model"]] {
         let mut command = amber();

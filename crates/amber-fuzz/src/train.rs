@@ -6,7 +6,7 @@ use std::path::Path;
 
 use amber_experiments::{CARD_FILE, ModelCard};
 use amber_tasks::poisson::PoissonProblem;
-use amber_train::{CnnConfig, LrSchedule, TrainError, TrainedModel, TrainingConfig};
+use amber_train::{CnnConfig, FinalStep, LrSchedule, TrainError, TrainedModel, TrainingConfig};
 
 use crate::{ELEMENT_CAP, assert_valid, scratch_dir};
 
@@ -103,7 +103,7 @@ fn apply(mut model: TrainedModel) {
     // The generator's own cap is four times the budget.
     limits.max_elements = limits.max_elements.min(ELEMENT_CAP / 4);
     limits.scale_to_budget = true;
-    match model.generate(&problem, 1, None) {
+    match model.generate(&problem, 1, FinalStep::default()) {
         Ok(steps) => {
             for step in steps {
                 assert_valid(&step.mesh);

@@ -299,9 +299,48 @@ pub const ELEMENT_COUNT_TOLERANCE: f64 = 0.05;
 /// Meshings [`mesh_to_element_count`] tries before it returns its closest mesh.
 const ELEMENT_COUNT_ATTEMPTS: usize = 5;
 
+/// The range a user allows a final mesh's sizing field (`amber mesh --min-size/--max-size`): an
+/// explicit solver's time step is set by its smallest element, a contact or a result plot wants no
+/// element above a size. Sizes outside are clamped after every other scaling, so the model still
+/// decides where elements go inside the range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SizeBounds {
+    min: f64,
+    max: f64,
+}
+
+impl Default for SizeBounds {
+    /// No bounds.
+    fn default() -> Self {
+        Self { min: 0.0, max: f64::INFINITY }
+    }
+}
+
+impl SizeBounds {
+    /// Sizes at least `min` and at most `max` (either may be absent); an error says why a range is
+    /// not one: a bound that is not a positive number, or `min` above `max`.
+    pub fn new(min: Option<f64>, max: Option<f64>) -> Result<Self, String> {
+        for (name, bound) in [("minimum", min), ("maximum", max)] {
+            if let Some(h) = bound.filter(|h| !(h.is_finite() && *h > 0.0)) {
+                return Err(format!("the {name} size must be a positive number, not {h}"));
+            }
+        }
+        let bounds = Self { min: min.unwrap_or(0.0), max: max.unwrap_or(f64::INFINITY) };
+        if bounds.min > bounds.max {
+            return Err(format!("the minimum size {} is above the maximum size {}", bounds.min, bounds.max));
+        }
+        Ok(bounds)
+    }
+
+    /// `h` moved into the range.
+    pub fn clamp(&self, h: f64) -> f64 {
+        h.clamp(self.min, self.max)
+    }
+}
+
 /// A new mesh of `domain` whose sizes follow the shape of the field `sizes` on `mesh`, scaled by
-/// one factor so that the mesh has about `target` elements: the budget knob of `amber mesh
-/// --elements`. The first factor makes the estimate Σ|K|/V(h) equal `target`; the generator's
+/// one factor (then held within `bounds`) so that the mesh has about `target` elements: the budget
+/// knob of `amber mesh --elements`. Bounds that forbid the count leave the closest mesh they allow. The first factor makes the estimate Σ|K|/V(h) equal `target`; the generator's
 /// count differs from the estimate (boundary grading, quality refinement, the 3D curvature cap), so
 /// each further attempt corrects the factor by (n/target)^(1/D) from the count n it got, until n is
 /// within [`ELEMENT_COUNT_TOLERANCE`] of `target` or [`ELEMENT_COUNT_ATTEMPTS`] meshings are spent;
@@ -311,6 +350,7 @@ pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
     mesh: &Mesh<D>,
     sizes: &[f64],
     target: usize,
+    bounds: SizeBounds,
     max_elements: usize,
 ) -> Result<Mesh<D>, ProblemError> {
     if target == 0 || target > max_elements {
@@ -329,7 +369,7 @@ pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
     let mut factor = (estimate / target_f).powf(1.0 / D as f64);
     let mut best: Option<Mesh<D>> = None;
     for _ in 0..ELEMENT_COUNT_ATTEMPTS {
-        let scaled = sizes.iter().map(|h| h * factor).collect();
+        let scaled = sizes.iter().map(|h| bounds.clamp(h * factor)).collect();
         let candidate = domain.remesh(mesh, scaled, max_elements)?;
         let count = candidate.num_elements() as f64;
         let miss = |m: &Mesh<D>| (m.num_elements() as f64 / target_f - 1.0).abs();
@@ -363,15 +403,55 @@ mod tests {
         let sizes: Vec<f64> = mesh.midpoints().iter().map(|x| 0.004 + 0.08 * (x[0] + x[1]) / 2.0).collect();
         let natural = holed.remesh(mesh, sizes.clone(), 1_000_000).unwrap().num_elements();
         for target in [natural / 4, natural, 4 * natural] {
-            let made = mesh_to_element_count(&holed, mesh, &sizes, target, 1_000_000).unwrap();
+            let made = mesh_to_element_count(&holed, mesh, &sizes, target, SizeBounds::default(), 1_000_000).unwrap();
             let ratio = made.num_elements() as f64 / target as f64;
             assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements for {target}", made.num_elements());
             assert!((made.total_volume() - 0.96).abs() < 1e-12);
             let near = made.midpoints().iter().filter(|x| x[0] + x[1] < 1.0).count();
             assert!(near > made.num_elements() / 2, "the grading is kept: {near} of {}", made.num_elements());
         }
-        assert!(mesh_to_element_count(&holed, mesh, &sizes, 10, 5).is_err());
+        assert!(mesh_to_element_count(&holed, mesh, &sizes, 10, SizeBounds::default(), 5).is_err());
         let broken: Vec<f64> = sizes.iter().map(|_| f64::NAN).collect();
-        assert!(mesh_to_element_count(&holed, mesh, &broken, 100, 1_000).is_err());
+        assert!(mesh_to_element_count(&holed, mesh, &broken, 100, SizeBounds::default(), 1_000).is_err());
+    }
+
+    /// The same graded field (sizes 0.004 to 0.084) held within [0.01, 0.025]: the count still
+    /// lands on the target, the sizes stay in the range but for the generator's own spread (about
+    /// ±15 %), and the grading is kept inside it.
+    #[test]
+    fn size_bounds_hold_the_field_while_the_count_is_met() {
+        let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![]).unwrap();
+        let square = PlanarPart::new("square".into(), domain, 0.1).unwrap();
+        let mesh = square.initial_mesh();
+        let sizes: Vec<f64> = mesh.midpoints().iter().map(|x| 0.004 + 0.08 * (x[0] + x[1]) / 2.0).collect();
+        let quantiles = |m: &Mesh<2>| {
+            let mut h = m.sizes();
+            h.sort_by(f64::total_cmp);
+            (quantile(&h, 0.02), quantile(&h, 0.98))
+        };
+        let unbounded = mesh_to_element_count(&square, mesh, &sizes, 8_000, SizeBounds::default(), 1_000_000).unwrap();
+        let (low, high) = quantiles(&unbounded);
+        assert!(
+            low < 0.007 && high > 0.032,
+            "the unbounded field leaves the range: 2 % and 98 % quantiles {low}, {high}"
+        );
+        let bounds = SizeBounds::new(Some(0.01), Some(0.025)).unwrap();
+        let made = mesh_to_element_count(&square, mesh, &sizes, 8_000, bounds, 1_000_000).unwrap();
+        let ratio = made.num_elements() as f64 / 8_000.0;
+        assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements", made.num_elements());
+        let (low, high) = quantiles(&made);
+        assert!(low > 0.0075 && high < 0.03, "2 % and 98 % quantiles {low}, {high}");
+        let near = made.midpoints().iter().filter(|x| x[0] + x[1] < 1.0).count();
+        assert!(near > made.num_elements() * 6 / 10, "the grading is kept: {near} of {}", made.num_elements());
+    }
+
+    #[test]
+    fn a_size_range_is_positive_and_ordered() {
+        assert!(SizeBounds::new(None, None).is_ok_and(|b| b.clamp(1e-9) == 1e-9 && b.clamp(1e9) == 1e9));
+        assert!(SizeBounds::new(Some(2.0), None).is_ok_and(|b| b.clamp(1.0) == 2.0 && b.clamp(3.0) == 3.0));
+        assert!(SizeBounds::new(Some(1.0), Some(1.0)).is_ok_and(|b| b.clamp(0.5) == 1.0 && b.clamp(3.0) == 1.0));
+        for (min, max) in [(Some(0.0), None), (None, Some(-1.0)), (Some(f64::NAN), None), (Some(2.0), Some(1.0))] {
+            assert!(SizeBounds::new(min, max).is_err(), "{min:?}, {max:?}");
+        }
     }
 }

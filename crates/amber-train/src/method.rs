@@ -9,7 +9,7 @@ use amber_tasks::{Domain, LOG_SIZE_COLUMN, MeshLimits, Problem};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError};
-use crate::rollout::{ElementTarget, GeneratedStep, fit_final_step_scale, generate};
+use crate::rollout::{FinalStep, GeneratedStep, fit_final_step_scale, generate};
 use crate::{
     AmberModel, CNN_PREDICTOR_FILE, CnnConfig, CnnModel, CnnTraining, DataConfig, Evaluation, MODEL_DIR, Rollout,
     Training, TrainingConfig, TrainingObserver,
@@ -152,18 +152,18 @@ impl TrainedModel {
         }
     }
 
-    /// Meshes `domain` (no expert needed): `steps` generation steps from its M⁰, the last one
-    /// aimed at `target` elements when given (see [`generate`]).
+    /// Meshes `domain` (no expert needed): `steps` generation steps from its M⁰, the last one as
+    /// `last` asks (see [`generate`]).
     pub fn generate<const D: usize, P: Domain<D>>(
         &self,
         domain: &P,
         steps: usize,
-        target: Option<ElementTarget>,
+        last: FinalStep,
     ) -> Result<Vec<GeneratedStep<D>>> {
         self.check_inputs(domain)?;
         match self {
-            TrainedModel::Amber(m) => generate(&m.sizing(), domain, steps, target),
-            TrainedModel::Cnn(m) => generate(&m.sizing(), domain, steps, target),
+            TrainedModel::Amber(m) => generate(&m.sizing(), domain, steps, last),
+            TrainedModel::Cnn(m) => generate(&m.sizing(), domain, steps, last),
         }
     }
 

@@ -10,7 +10,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, in_problem};
-use amber_tasks::{Domain, MeshLimits, Problem, ProblemError, StepOutcome, generation_step, mesh_to_element_count};
+use amber_tasks::{
+    Domain, MeshLimits, Problem, ProblemError, SizeBounds, StepOutcome, generation_step, mesh_to_element_count,
+};
 
 /// The per-problem constants of the normalised DCD: the reconstruction M̂ (the generator run
 /// with the expert's own sizing field, clipped at h_min) and the DCDs of M⁰ and M̂ to M*.
@@ -219,6 +221,14 @@ pub struct GeneratedStep<const D: usize> {
     pub mesh: Mesh<D>,
 }
 
+/// What a user asks of the last step of [`generate`]: an element count, and a range for its
+/// sizes. The default asks nothing: the model's own final step scale decides.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FinalStep {
+    pub target: Option<ElementTarget>,
+    pub bounds: SizeBounds,
+}
+
 /// An element count to aim the last step of [`generate`] at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ElementTarget {
@@ -230,30 +240,31 @@ pub struct ElementTarget {
 }
 
 /// Meshes `domain` with `model` for `steps` generation steps from its M⁰ (predict, clip at
-/// h_min, budget guard, mesh), as a rollout does but without an expert to compare with. With a
-/// `target`, the last step's field keeps its shape and is scaled to the target's element count
-/// (instead of the budget guard): the model decides where elements go, the user how many;
-/// without one, by the model's `final_step_scale`. A step that makes no mesh is an error naming
-/// the step.
+/// h_min, budget guard, mesh), as a rollout does but without an expert to compare with. The
+/// last step does what `last` asks: with a target, its field keeps its shape and is scaled to
+/// the target's element count (instead of the budget guard): the model decides where elements
+/// go, the user how many; without one, by the model's `final_step_scale`; either way its sizes
+/// are then held within `last.bounds`. A step that makes no mesh is an error naming the step.
 pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     model: &M,
     domain: &P,
     steps: usize,
-    target: Option<ElementTarget>,
+    last: FinalStep,
 ) -> Result<Vec<GeneratedStep<D>>> {
     let mut out: Vec<GeneratedStep<D>> = Vec::with_capacity(steps);
     for step in 1..=steps {
         let current = out.last().map_or(domain.initial_mesh(), |s| &s.mesh);
         let mut field = model.predict(&[domain], &[current])?.pop().expect("one field per domain");
-        if step == steps && target.is_none() {
+        if step == steps && last.target.is_none() {
             field.scale(model.limits().final_step_scale);
+            field.sizes.iter_mut().for_each(|h| *h = last.bounds.clamp(*h));
         }
         let on = field.mesh.as_ref().unwrap_or(current);
-        let mesh = match target.filter(|_| step == steps) {
+        let mesh = match last.target.filter(|_| step == steps) {
             Some(target) => {
                 let min_size = model.limits().min_size;
                 let sizes: Vec<f64> = field.sizes.iter().map(|h| h.max(min_size)).collect();
-                mesh_to_element_count(domain, on, &sizes, target.elements, target.max_elements)
+                mesh_to_element_count(domain, on, &sizes, target.elements, last.bounds, target.max_elements)
                     .map_err(|e| TrainError::Generation { step, reason: e.to_string() })?
             }
             None => match generation_step(domain, on, field.sizes.clone(), model.limits()) {
@@ -299,7 +310,7 @@ pub fn fit_final_step_scale<const D: usize, P: Problem<D>, M: SizingModel + ?Siz
     let last_fields: Vec<(&P, Mesh<D>, PredictedField<D>)> = problems
         .par_iter()
         .filter_map(|p| {
-            let before = generate(model, p, steps.saturating_sub(1), None).ok()?;
+            let before = generate(model, p, steps.saturating_sub(1), FinalStep::default()).ok()?;
             let mesh = before.last().map_or(p.initial_mesh(), |s| &s.mesh).clone();
             let field = model.predict(&[p], &[&mesh]).ok()?.pop()?;
             Some((p, mesh, field))
@@ -467,10 +478,10 @@ mod tests {
         let mut model = Uniform { size: 0.08, limits };
         let scale = fit_final_step_scale(&model, &problems, 2).unwrap();
         assert!((0.45..0.55).contains(&scale), "scale {scale}");
-        let unscaled = generate(&model, &problems[1], 2, None).unwrap();
+        let unscaled = generate(&model, &problems[1], 2, FinalStep::default()).unwrap();
         model.limits.final_step_scale = scale;
         assert!(fit_final_step_scale(&model, &problems, 2).is_err(), "a scaled model is refitted from 1");
-        let scaled = generate(&model, &problems[1], 2, None).unwrap();
+        let scaled = generate(&model, &problems[1], 2, FinalStep::default()).unwrap();
         assert_eq!(scaled[0].mesh.num_elements(), unscaled[0].mesh.num_elements());
         let (made, expert) = (scaled[1].mesh.num_elements() as f64, problems[1].expert_mesh.num_elements() as f64);
         assert!((made / expert - 1.0).abs() < 0.05, "{made} elements for the expert's {expert}");
