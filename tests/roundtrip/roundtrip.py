@@ -9,7 +9,9 @@ read:  meshio and gmsh write a 2D triangle mesh and a 3D tetrahedral mesh (with 
 write: `amber convert` writes a reference mesh (JSON with `size`) in every format and encoding
        it has; meshio and gmsh read each back: same vertex and element counts, same coordinates
        (to 1e-12), `size` preserved (meshio, where the format stores cell data), physical groups
-       present (.msh), the boundary's node set (.inp).
+       present (.msh), the boundary's node set (.inp). Then again as second-order elements
+       (`--order 2`): their corners are the reference's elements, each edge node sits at its
+       edge's midpoint in the reader's node order, the .inp node set has the edge nodes too.
 
 Prints a table format x encoding x direction x tool -> pass/fail (the tool that wrote the file
 for `read`, the one that read amber's file for `write`) and exits non-zero on any failure.
@@ -278,6 +280,77 @@ def read_with_meshio(path, dim, points, cells, size, has_data, physical):
         same_points(np.asarray(points)[boundary], got_points[np.asarray(m.point_sets["boundary"])])
 
 
+# The edges of a second-order element, in the order of its edge nodes: meshio's (VTK's, also
+# NASTRAN's and Abaqus's) and gmsh's, which differ in a tetra10's last two.
+EDGES = {"vtk": {2: [(0, 1), (1, 2), (2, 0)], 3: [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]}}
+EDGES["gmsh"] = {2: EDGES["vtk"][2], 3: [(0, 1), (1, 2), (2, 0), (0, 3), (2, 3), (1, 3)]}
+
+
+def same_quadratic(points, cells, got_points, got, edges):
+    """Second-order elements: their corners are the reference's elements, each edge node lies at
+    its edge's midpoint (to TOL), and there is one node per vertex and per edge."""
+    got = np.asarray(got, dtype=int)
+    corners = got[:, : got.shape[1] - len(edges)]
+    same_cells(points, cells, got_points, corners)
+    for k, (a, b) in enumerate(edges):
+        midpoint = 0.5 * (got_points[corners[:, a]] + got_points[corners[:, b]])
+        diff = np.abs(got_points[got[:, corners.shape[1] + k]] - midpoint).max()
+        if diff > TOL:
+            raise AssertionError(f"edge node {k} lies {diff} off its edge's midpoint")
+    edge_count = len({tuple(sorted((c[a], c[b]))) for c in corners.tolist() for a, b in edges})
+    if len(got_points) != len(points) + edge_count:
+        raise AssertionError(f"{len(got_points)} nodes for {len(points)} vertices and {edge_count} edges")
+
+
+def boundary_facets(cells, dim):
+    """The facets (sorted vertex tuples) that one element alone has."""
+    faces = [tuple(sorted(np.delete(c, k))) for c in np.asarray(cells).tolist() for k in range(dim + 1)]
+    counts = {}
+    for f in faces:
+        counts[f] = counts.get(f, 0) + 1
+    return [f for f, n in counts.items() if n == 1]
+
+
+def read_quadratic_with_meshio(path, dim, points, cells, size, has_data):
+    if path.endswith(".inp") and dim == 2:
+        # meshio 5.3 lacks CPS6, Abaqus's plane-stress 6-node triangle; its plane-strain CPE6 has
+        # the same nodes.
+        with open(path) as f:
+            text = f.read()
+        path = path[: -len(".inp")] + "-cpe6.inp"
+        with open(path, "w") as f:
+            f.write(text.replace("TYPE=CPS6", "TYPE=CPE6"))
+    m = meshio_read(path)
+    got = np.concatenate([c.data for c in m.cells if c.type == QUADRATIC[dim]])
+    got_points = np.zeros((len(m.points), 3))
+    got_points[:, : m.points.shape[1]] = m.points
+    same_quadratic(points, cells, got_points, got, EDGES["vtk"][dim])
+    if has_data:
+        blocks = [np.ravel(d) for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == QUADRATIC[dim]]
+        same_values(size, np.concatenate(blocks) if blocks else None, "cell data `size`")
+    if path.endswith(".inp"):
+        # The boundary's node set holds the edge nodes of the boundary facets too.
+        facets = boundary_facets(cells, dim)
+        points = np.asarray(points)
+        corners = points[sorted({v for f in facets for v in f})]
+        midpoints = {tuple(0.5 * (points[a] + points[b])) for f in facets for a in f for b in f if a < b}
+        same_points(np.vstack([corners, sorted(midpoints)]), got_points[np.asarray(m.point_sets["boundary"])])
+
+
+def read_quadratic_with_gmsh(path, dim, points, cells):
+    restart_gmsh()
+    gmsh.open(path)
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    got_points = np.asarray(coords).reshape(-1, 3)
+    index = {t: i for i, t in enumerate(tags)}
+    types, _, nodes = gmsh.model.mesh.getElements(dim)
+    blocks = [n for t, n in zip(types, nodes) if t in (9, 11)]
+    if not blocks:
+        raise AssertionError(f"element types {list(types)}, no second-order simplices")
+    got = np.array([index[t] for t in np.concatenate(blocks)]).reshape(-1, len(EDGES["gmsh"][dim]) + dim + 1)
+    same_quadratic(points, cells, got_points, got, EDGES["gmsh"][dim])
+
+
 def restart_gmsh():
     """A fresh gmsh: after a failed open gmsh 4.15 stays "busy" and ignores the next ones."""
     if gmsh.isInitialized():
@@ -360,6 +433,21 @@ def main():
                 if fmt in ("msh", "mesh", "nas") or (fmt, encoding) == ("vtk", "ascii"):
                     record(fmt, f"{encoding} {dim}D", "write", "gmsh",
                            lambda: read_with_gmsh(path, dim, points, cells, fmt == "msh"))
+            for fmt, encoding, flags in outputs:
+                if fmt == "mesh":
+                    continue
+                path = os.path.join(directory, f"amber{dim}-{encoding}-order2.{fmt}")
+                kind = f"{encoding} {dim}D {QUADRATIC[dim]}"
+                try:
+                    amber_convert(ref, path, "--order", "2", *flags)
+                except Exception as e:  # noqa: BLE001
+                    record(fmt, kind, "write", "amber", lambda e=e: (_ for _ in ()).throw(e))
+                    continue
+                has_data = fmt in ("vtu", "vtk", "msh")
+                record(fmt, kind, "write", "meshio",
+                       lambda: read_quadratic_with_meshio(path, dim, points, cells, size, has_data))
+                if fmt in ("msh", "nas") or (fmt, encoding) == ("vtk", "ascii"):
+                    record(fmt, kind, "write", "gmsh", lambda: read_quadratic_with_gmsh(path, dim, points, cells))
     gmsh.finalize()
 
     width = [max(len(r[i]) for r in results) for i in range(5)]

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use amber_mesh::{AnyMesh, Encoding, Mesh, MeshData, read_any_mesh, write_mesh_as};
+use amber_mesh::{AnyMesh, ElementOrder, Encoding, Mesh, MeshData, WriteOptions, read_any_mesh, write_mesh_as};
 use anyhow::Context;
 use clap::Args;
 
@@ -21,6 +21,19 @@ pub struct ConvertArgs {
     /// Write .msh, .vtu or .vtk as text.
     #[arg(long)]
     ascii: bool,
+    /// Element order of the output: 1, or 2 for 10-node tetrahedra and 6-node triangles with
+    /// their edge nodes at the edges' midpoints (.msh, .vtu, .vtk, .nas, .inp).
+    #[arg(long, default_value = "1", value_parser = parse_order)]
+    order: ElementOrder,
+}
+
+/// `--order`: 1 or 2.
+pub(crate) fn parse_order(text: &str) -> Result<ElementOrder, String> {
+    match text {
+        "1" => Ok(ElementOrder::Linear),
+        "2" => Ok(ElementOrder::Quadratic),
+        _ => Err(format!("the element order is 1 or 2, not `{text}`")),
+    }
 }
 
 pub fn run(args: ConvertArgs) -> anyhow::Result<()> {
@@ -45,14 +58,16 @@ fn write<const D: usize>(
     args: &ConvertArgs,
     encoding: Option<Encoding>,
 ) -> anyhow::Result<String> {
-    write_mesh_as(mesh, &args.output, data, encoding).context("cannot write the output mesh")?;
+    let options = WriteOptions { encoding, order: args.order };
+    write_mesh_as(mesh, &args.output, data, options).context("cannot write the output mesh")?;
     let mut summary = format!(
-        "{} -> {}: {} vertices, {} {}D elements, {} cell and {} point fields, {} tagged facets",
+        "{} -> {}: {} vertices, {} {}D elements{}, {} cell and {} point fields, {} tagged facets",
         args.input.display(),
         args.output.display(),
         mesh.num_vertices(),
         mesh.num_elements(),
         D,
+        if args.order == ElementOrder::Quadratic { " written as second order" } else { "" },
         data.cell.len(),
         data.point.len(),
         data.facet_tags.len()

@@ -5,7 +5,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use amber_experiments::{ModelCard, Task, resolve_model};
-use amber_mesh::{AnyMesh, Mesh, Mesh2, Mesh3, MeshData, read_any_mesh, read_mesh, read_mesh_with_data, write_mesh};
+use amber_mesh::{
+    AnyMesh, ElementOrder, Mesh, Mesh2, Mesh3, MeshData, WriteOptions, read_any_mesh, read_mesh, read_mesh_with_data,
+    write_mesh, write_mesh_as,
+};
 use amber_meshgen::mesh3d::{Mesh3dParams, SurfaceDistance, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
 use amber_metrics::{SizeRatios, log_size_ratios};
@@ -76,9 +79,14 @@ pub struct MeshArgs {
     /// Refuse to build more elements than this.
     #[arg(long, default_value_t = 5_000_000)]
     max_elements: usize,
-    /// Output: .vtu (ParaView), .msh (gmsh 4.1), .json, or .png (a picture coloured by element size).
+    /// Output: .vtu (ParaView), .msh (gmsh 4.1, one physical group per CAD face), .inp (Abaqus),
+    /// .nas (NASTRAN), .vtk, .mesh (medit), .json, or .png (a picture coloured by element size).
     #[arg(short, long)]
     output: PathBuf,
+    /// Element order of the output: 1, or 2 for 10-node tetrahedra and 6-node triangles (edge
+    /// nodes at the edges' midpoints; .msh, .vtu, .vtk, .nas, .inp).
+    #[arg(long, default_value = "1", value_parser = crate::convert::parse_order)]
+    order: ElementOrder,
 }
 
 pub fn run(args: MeshArgs) -> anyhow::Result<()> {
@@ -201,7 +209,7 @@ where
     if let Some(ratios) = &log_ratios {
         data = data.with_cell("log_size_ratio_to_expert", ratios.clone());
     }
-    write_output(last, &args.output, data)?;
+    write_output(last, args, data)?;
     for (t, (step, metrics)) in generated.iter().zip(&metrics).enumerate() {
         let score = metrics.map_or(String::new(), |m| {
             format!(
@@ -295,10 +303,10 @@ fn degenerate_elements<const D: usize>(mesh: &Mesh<D>) -> (f64, usize) {
     (smallest, angles.iter().filter(|&&a| a < DEGENERATE_ANGLE_DEGREES).count())
 }
 
-/// Writes `mesh` to `output` by extension, with its element sizes added to `data` (fields and
-/// facet tags); `.png` is a picture. Says how well shaped the mesh is, with a warning when
-/// elements are nearly degenerate.
-fn write_output<const D: usize>(mesh: &Mesh<D>, output: &Path, data: MeshData) -> anyhow::Result<()>
+/// Writes `mesh` to `--output` by extension, in `--order`, with its element sizes added to `data`
+/// (fields and facet tags); `.png` is a picture. Says how well shaped the mesh is, with a warning
+/// when elements are nearly degenerate.
+fn write_output<const D: usize>(mesh: &Mesh<D>, args: &MeshArgs, data: MeshData) -> anyhow::Result<()>
 where
     Mesh<D>: Picture,
 {
@@ -321,12 +329,16 @@ where
             mesh.num_elements()
         );
     }
+    let output = &args.output;
     match output.extension().and_then(|e| e.to_str()) {
         Some("png") => {
             let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
             mesh.picture(&sizes, &options, output)
         }
-        _ => Ok(write_mesh(mesh, output, &data.with_cell("size", sizes))?),
+        _ => {
+            let options = WriteOptions { order: args.order, ..WriteOptions::default() };
+            Ok(write_mesh_as(mesh, output, &data.with_cell("size", sizes), options)?)
+        }
     }
 }
 
@@ -340,7 +352,7 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
         let params = Mesh3dParams::default().with_max_elements(args.max_elements);
         let mesh = generate_3d(&surface, &ConstantSize(h), &params).context("mesh generation failed")?;
         let facet_tags = cad_face_tags(&SurfaceDistance::new(&surface), &mesh);
-        write_output(&mesh, &args.output, MeshData { facet_tags, ..MeshData::new() })?;
+        write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
         eprintln!(
             "{} tetrahedra in {:.3} s; wrote {}",
             mesh.num_elements(),
@@ -359,7 +371,7 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
         }
     };
     let seconds = start.elapsed().as_secs_f64();
-    write_output(&mesh, &args.output, MeshData::new())?;
+    write_output(&mesh, args, MeshData::new())?;
     eprintln!(
         "{} triangles in {seconds:.3} s; size ratio median {:.3} (p10 {:.3}, p90 {:.3}); mean smallest angle {:.1}°; wrote {}",
         mesh.num_elements(),

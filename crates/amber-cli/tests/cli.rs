@@ -29,6 +29,17 @@ fn meshes_an_lshape_and_remeshes_from_the_result() {
     let picture = dir.path().join("mesh.png");
     assert!(amber().args(["mesh", "--size", "0.1", "-o"]).arg(&picture).status().unwrap().success());
     assert!(std::fs::metadata(&picture).unwrap().len() > 1000);
+
+    // Second order for Abaqus: 6-node triangles over the same corners; medit has none.
+    let quadratic = dir.path().join("quadratic.inp");
+    let args = ["mesh", "--corner", "0.3,0.6", "--size", "0.05", "--order", "2", "-o"];
+    assert!(amber().args(args).arg(&quadratic).status().unwrap().success());
+    let (corners, data) = amber_mesh::read_mesh_with_data::<2>(&quadratic).unwrap();
+    assert_eq!(corners, mesh);
+    assert_eq!(data.linearised.get("triangle6"), Some(&mesh.num_elements()));
+    let output = amber().args(args).arg(dir.path().join("quadratic.mesh")).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("second-order"), "{stderr}");
 }
 
 #[test]

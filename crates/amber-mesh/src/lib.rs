@@ -3,9 +3,10 @@
 //! A [`Mesh<D>`] holds vertices and positively oriented simplices (triangles for `D = 2`,
 //! tetrahedra for `D = 3`). It answers per-element geometry (volume, midpoint, the element size
 //! h(K) of spec §0), facet adjacency ([`FacetAdjacency`]) and point location ([`PointLocator`]).
-//! It reads and writes meshes ([`read_mesh`], [`write_mesh`]: `.vtu`, gmsh `.msh` 4.1, JSON,
-//! NASTRAN `.nas` read only) and reads the triangles of surface files ([`read_surface`]: binary
-//! and ASCII STL, OBJ).
+//! It reads and writes meshes ([`read_mesh`], [`write_mesh`]: `.vtu`, `.vtk`, gmsh `.msh`,
+//! NASTRAN `.nas`, Abaqus `.inp`, medit `.mesh`, JSON; second-order elements with
+//! [`write_mesh_as`]) and reads the triangles of surface files ([`read_surface`]: binary and ASCII
+//! STL, OBJ).
 //!
 //! This crate knows nothing of sizing fields, mesh generation, FEM, graphs or learning.
 
@@ -18,8 +19,8 @@ mod mesh;
 pub use adjacency::FacetAdjacency;
 pub use error::MeshError;
 pub use io::{
-    AnyMesh, Encoding, MESH_FORMATS, MeshData, StlFaceIds, TriangleSoup, parse_any_mesh, parse_surface, read_any_mesh,
-    read_mesh, read_mesh_with_data, read_surface, write_mesh, write_mesh_as,
+    AnyMesh, ElementOrder, Encoding, MESH_FORMATS, MeshData, StlFaceIds, TriangleSoup, WriteOptions, parse_any_mesh,
+    parse_surface, read_any_mesh, read_mesh, read_mesh_with_data, read_surface, write_mesh, write_mesh_as,
 };
 pub use locate::{Location, PointLocator};
 pub use mesh::{Mesh, Mesh2, Mesh3, bounding_box, centroid, signed_volume, size_from_volume, volume_from_size};

@@ -694,7 +694,7 @@ mod tests {
             &plate,
             &binary,
             &amber_mesh::MeshData::default(),
-            Some(amber_mesh::Encoding::Binary),
+            amber_mesh::WriteOptions { encoding: Some(amber_mesh::Encoding::Binary), ..Default::default() },
         )
         .unwrap();
         let bytes = std::fs::read(&binary).unwrap();

@@ -3,7 +3,8 @@
 //! keyword's data is skipped). Element types are classified by their family prefix and node
 //! count (`C3D4` tetrahedron, `CPS3`/`CPE3`/`S3`/... triangle, `C3D10` and `CPS6`/... read by their
 //! corners, ...).
-//! The writer writes `*NODE` and one `*ELEMENT` block, `C3D4` or `CPS3`, in ELSET `domain`, and
+//! The writer writes `*NODE` and one `*ELEMENT` block, `C3D4` or `CPS3` (second order: `C3D10`,
+//! `CPS6`, their edge nodes at the edges' midpoints), in ELSET `domain`, and
 //! the boundary as one `*NSET` (for boundary conditions) and one element-side `*SURFACE` (for
 //! loads) per facet tag, `boundary_<tag>` (`boundary` when nothing is tagged), as the `.msh`
 //! writer groups it; tagged facets inside the mesh are left out, a surface being one-sided.
@@ -12,9 +13,10 @@ use std::collections::{BTreeMap, HashMap};
 use std::io::Write;
 use std::path::Path;
 
+use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
 use super::{Lines, MeshData, tagged_facets, write_error};
-use crate::{FacetAdjacency, Mesh, MeshError};
+use crate::{FacetAdjacency, MeshError};
 
 /// The kind of an Abaqus element type: the family prefix gives the dimension, the digits after it
 /// the node count.
@@ -149,11 +151,12 @@ fn side_opposite<const D: usize>(local: usize) -> usize {
 }
 
 pub(super) fn write<const D: usize>(
-    mesh: &Mesh<D>,
+    nodes: &Nodes<D>,
     data: &MeshData,
     w: &mut impl Write,
     path: &Path,
 ) -> Result<(), MeshError> {
+    let mesh = nodes.mesh();
     let adjacency = FacetAdjacency::new(mesh)?;
     let side_of: HashMap<Vec<u32>, (usize, usize)> = adjacency
         .boundary_facets()
@@ -172,43 +175,53 @@ pub(super) fn write<const D: usize>(
             groups.entry(tag).or_default().push(side);
         }
     }
-    write_body(mesh, &groups, w).map_err(write_error(path))
+    write_body(nodes, &groups, w).map_err(write_error(path))
 }
 
 fn write_body<const D: usize>(
-    mesh: &Mesh<D>,
+    nodes: &Nodes<D>,
     groups: &BTreeMap<i32, Vec<(usize, usize)>>,
     w: &mut impl Write,
 ) -> std::io::Result<()> {
+    let mesh = nodes.mesh();
     writeln!(w, "*HEADING\nwritten by amber\n*NODE")?;
-    for (i, p) in mesh.vertices().iter().enumerate() {
+    for (i, p) in nodes.points().enumerate() {
         write!(w, "{}", i + 1)?;
         for x in p {
             write!(w, ", {x:?}")?;
         }
         writeln!(w)?;
     }
-    writeln!(w, "*ELEMENT, TYPE={}, ELSET=domain", if D == 3 { "C3D4" } else { "CPS3" })?;
-    for (e, cell) in mesh.elements().enumerate() {
+    let kind = match (D, nodes.is_quadratic()) {
+        (2, false) => "CPS3",
+        (2, true) => "CPS6",
+        (_, false) => "C3D4",
+        (_, true) => "C3D10",
+    };
+    writeln!(w, "*ELEMENT, TYPE={kind}, ELSET=domain")?;
+    for (e, cell) in nodes.elements().enumerate() {
         write!(w, "{}", e + 1)?;
-        for &v in cell {
+        for v in cell {
             write!(w, ", {}", v + 1)?;
         }
         writeln!(w)?;
     }
     for (tag, sides) in groups {
         let name = if groups.len() == 1 { "boundary".to_owned() } else { format!("boundary_{tag}").replace('-', "m") };
-        let mut nodes: Vec<u32> = sides
+        // Every node on the group's faces, edge nodes too: a boundary condition holds them all.
+        let mut on_faces: Vec<u32> = sides
             .iter()
             .flat_map(|&(e, local)| {
-                mesh.element(e).iter().enumerate().filter(move |&(k, _)| k != local).map(|(_, &v)| v)
+                let corners: Vec<u32> =
+                    mesh.element(e).iter().enumerate().filter(|&(k, _)| k != local).map(|(_, &v)| v).collect();
+                nodes.facet(&corners)
             })
             .collect();
-        nodes.sort_unstable();
-        nodes.dedup();
+        on_faces.sort_unstable();
+        on_faces.dedup();
         writeln!(w, "*NSET, NSET={name}")?;
         // Abaqus reads at most 16 entries per data line.
-        for line in nodes.chunks(16) {
+        for line in on_faces.chunks(16) {
             let ids: Vec<String> = line.iter().map(|v| (v + 1).to_string()).collect();
             writeln!(w, "{}", ids.join(", "))?;
         }
@@ -223,6 +236,8 @@ fn write_body<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Mesh;
+    use crate::io::ElementOrder;
     use crate::{Mesh2, MeshData};
 
     fn parse<const D: usize>(text: &str) -> Result<(Mesh<D>, MeshData), MeshError> {
@@ -247,7 +262,7 @@ mod tests {
     fn writes_what_it_reads() {
         let mesh = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0 / 3.0, 1.0]], vec![0, 1, 2]).unwrap();
         let mut bytes = Vec::new();
-        write(&mesh, &MeshData::new(), &mut bytes, Path::new("x.inp")).unwrap();
+        write(&Nodes::new(&mesh, ElementOrder::Linear), &MeshData::new(), &mut bytes, Path::new("x.inp")).unwrap();
         let text = std::str::from_utf8(&bytes).unwrap();
         assert_eq!(parse::<2>(text).unwrap().0, mesh);
         assert!(
@@ -267,7 +282,7 @@ mod tests {
         let data =
             MeshData::new().with_facet_tag([0, 1, 2], 5).with_facet_tag([0, 3, 1], 7).with_facet_tag([1, 3, 2], 7);
         let mut bytes = Vec::new();
-        write(&tet.unwrap(), &data, &mut bytes, Path::new("x.inp")).unwrap();
+        write(&Nodes::new(&tet.unwrap(), ElementOrder::Linear), &data, &mut bytes, Path::new("x.inp")).unwrap();
         let text = std::str::from_utf8(&bytes).unwrap();
         let groups = text.split_once("*NSET").unwrap().1;
         assert_eq!(

@@ -18,6 +18,7 @@ mod json;
 mod medit;
 mod msh;
 mod nastran;
+mod nodes;
 mod obj;
 mod raw;
 mod stl;
@@ -27,6 +28,8 @@ mod vtu;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+pub use self::nodes::ElementOrder;
+use self::nodes::Nodes;
 use crate::{Mesh, Mesh2, Mesh3, MeshError};
 
 /// What travels with a mesh in a file: named scalar fields with one value per element (`cell`)
@@ -311,44 +314,61 @@ fn parse_point<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<[f64; 3],
 /// # Ok::<(), amber_mesh::MeshError>(())
 /// ```
 pub fn write_mesh<const D: usize>(mesh: &Mesh<D>, path: impl AsRef<Path>, data: &MeshData) -> Result<(), MeshError> {
-    write_mesh_as(mesh, path, data, None)
+    write_mesh_as(mesh, path, data, WriteOptions::default())
 }
 
-/// [`write_mesh`] in a chosen encoding (`None`: the format's default). `.msh`, `.vtu` and
-/// `.vtk` have both; asking a text-only format for binary is an error.
+/// How [`write_mesh_as`] writes: the encoding (`None`: the format's default; `.msh`, `.vtu` and
+/// `.vtk` have both, asking a text-only format for binary is an error) and the element order
+/// (second order in `.msh`, `.vtu`, `.vtk`, `.nas` and `.inp`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    pub encoding: Option<Encoding>,
+    pub order: ElementOrder,
+}
+
+/// [`write_mesh`] with [`WriteOptions`].
 ///
 /// ```no_run
 /// # let mesh = amber_mesh::Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2])?;
 /// // Edges 0-1 and 1-2 in physical group 3, edge 2-0 in group 4.
 /// let data = amber_mesh::MeshData::new().with_facet_tag([0, 1], 3).with_facet_tag([1, 2], 3).with_facet_tag([2, 0], 4);
-/// amber_mesh::write_mesh_as(&mesh, "solver.msh", &data, Some(amber_mesh::Encoding::Binary))?;
+/// let options = amber_mesh::WriteOptions { encoding: Some(amber_mesh::Encoding::Binary), ..Default::default() };
+/// amber_mesh::write_mesh_as(&mesh, "solver.msh", &data, options)?;
+/// // 10-node tetrahedra for Abaqus.
+/// # let mesh = amber_mesh::Mesh3::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3])?;
+/// let options = amber_mesh::WriteOptions { order: amber_mesh::ElementOrder::Quadratic, ..Default::default() };
+/// amber_mesh::write_mesh_as(&mesh, "part.inp", &amber_mesh::MeshData::new(), options)?;
 /// # Ok::<(), amber_mesh::MeshError>(())
 /// ```
 pub fn write_mesh_as<const D: usize>(
     mesh: &Mesh<D>,
     path: impl AsRef<Path>,
     data: &MeshData,
-    encoding: Option<Encoding>,
+    options: WriteOptions,
 ) -> Result<(), MeshError> {
     let path = path.as_ref();
     let format = format_of(path)
         .ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: MESH_FORMATS })?;
     data.check_lengths(path, mesh.num_elements(), mesh.num_vertices())?;
-    let binary = match (format, encoding) {
+    let binary = match (format, options.encoding) {
         (Format::Vtu, None) | (_, Some(Encoding::Binary)) => true,
         (_, None | Some(Encoding::Ascii)) => false,
     };
+    let refuse = |message: &str| Err(MeshError::Format { path: path.to_owned(), message: message.to_owned() });
     if binary && !matches!(format, Format::Vtu | Format::Vtk | Format::Msh) {
-        let message = "this format has no binary encoding".to_owned();
-        return Err(MeshError::Format { path: path.to_owned(), message });
+        return refuse("this format has no binary encoding");
     }
+    if options.order == ElementOrder::Quadratic && matches!(format, Format::Json | Format::Medit) {
+        return refuse("second-order elements are written to .msh, .vtu, .vtk, .nas and .inp only");
+    }
+    let nodes = Nodes::new(mesh, options.order);
     match format {
-        Format::Vtu => write_atomic(path, |w| vtu::write(mesh, data, binary, w).map_err(write_error(path))),
-        Format::Vtk => write_atomic(path, |w| vtk::write(mesh, data, binary, w, path)),
-        Format::Msh => write_atomic(path, |w| msh::write(mesh, data, binary, w, path)),
+        Format::Vtu => write_atomic(path, |w| vtu::write(&nodes, data, binary, w).map_err(write_error(path))),
+        Format::Vtk => write_atomic(path, |w| vtk::write(&nodes, data, binary, w, path)),
+        Format::Msh => write_atomic(path, |w| msh::write(&nodes, data, binary, w, path)),
         Format::Json => write_atomic(path, |w| json::write(mesh, data, w, path)),
-        Format::Nastran => write_atomic(path, |w| nastran::write(mesh, w).map_err(write_error(path))),
-        Format::Abaqus => write_atomic(path, |w| abaqus::write(mesh, data, w, path)),
+        Format::Nastran => write_atomic(path, |w| nastran::write(&nodes, w).map_err(write_error(path))),
+        Format::Abaqus => write_atomic(path, |w| abaqus::write(&nodes, data, w, path)),
         Format::Medit => write_atomic(path, |w| medit::write(mesh, data, w, path)),
     }
 }
@@ -522,7 +542,7 @@ mod tests {
         for ext in ["vtu", "vtk", "msh", "json", "nas", "inp", "mesh", "VTU"] {
             for encoding in encodings {
                 let p2 = dir.join(format!("m2.{ext}"));
-                let written = write_mesh_as(&m2, &p2, &d2, encoding);
+                let written = write_mesh_as(&m2, &p2, &d2, WriteOptions { encoding, ..Default::default() });
                 if encoding == Some(Encoding::Binary) && !matches!(ext, "vtu" | "vtk" | "msh" | "VTU") {
                     assert!(written.unwrap_err().to_string().contains("no binary encoding"), "{ext}");
                     continue;
@@ -538,7 +558,7 @@ mod tests {
                 let boundary_edges = if matches!(ext, "msh" | "mesh") { 4 } else { 0 };
                 assert_eq!(data.facet_tags.len(), boundary_edges, "{ext}");
                 let p3 = dir.join(format!("m3.{ext}"));
-                write_mesh_as(&m3, &p3, &d3, encoding).unwrap();
+                write_mesh_as(&m3, &p3, &d3, WriteOptions { encoding, ..Default::default() }).unwrap();
                 let (back, data) = read_mesh_with_data::<3>(&p3).unwrap();
                 assert_eq!(back, m3, "{ext} {encoding:?}");
                 assert_eq!(data.cell, if has_fields { d3.cell.clone() } else { Default::default() });
@@ -548,6 +568,49 @@ mod tests {
         let leftovers: Vec<_> =
             std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
         assert!(leftovers.iter().all(|n| !n.to_string_lossy().ends_with(".tmp")), "{leftovers:?}");
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    /// Second-order output through amber's own readers, which keep the corners: the same mesh bit
+    /// for bit, every element counted as linearised, the fields and boundary groups kept; the
+    /// formats without second-order elements refuse it.
+    #[test]
+    fn second_order_output_reads_back_as_its_corner_mesh() {
+        let dir = test_dir("second-order");
+        let m2 = square();
+        let d2 = MeshData::new().with_cell("h", m2.sizes()).with_point("u", vec![0.0, 0.5, 1.0, 0.1 + 0.2]);
+        let m3 = tet();
+        let d3 = MeshData::new().with_cell("h", m3.sizes()).with_facet_tag([0, 1, 2], 7);
+        for ext in ["vtu", "vtk", "msh", "nas", "inp", "json", "mesh"] {
+            for encoding in [Some(Encoding::Ascii), Some(Encoding::Binary)] {
+                if encoding == Some(Encoding::Binary) && !matches!(ext, "vtu" | "vtk" | "msh") {
+                    continue;
+                }
+                let options = WriteOptions { encoding, order: ElementOrder::Quadratic };
+                let p2 = dir.join(format!("m2.{ext}"));
+                let written = write_mesh_as(&m2, &p2, &d2, options);
+                if matches!(ext, "json" | "mesh") {
+                    assert!(written.unwrap_err().to_string().contains("second-order"), "{ext}");
+                    continue;
+                }
+                written.unwrap();
+                let (back, data) = read_mesh_with_data::<2>(&p2).unwrap();
+                assert_eq!(back, m2, "{ext} {encoding:?}");
+                assert_eq!(data.linearised, BTreeMap::from([("triangle6".to_owned(), 2)]), "{ext}");
+                if matches!(ext, "vtu" | "vtk" | "msh") {
+                    assert_eq!((&data.cell, &data.point), (&d2.cell, &d2.point), "{ext}");
+                }
+                let p3 = dir.join(format!("m3.{ext}"));
+                write_mesh_as(&m3, &p3, &d3, options).unwrap();
+                let (back, data) = read_mesh_with_data::<3>(&p3).unwrap();
+                assert_eq!(back, m3, "{ext} {encoding:?}");
+                assert_eq!(data.linearised, BTreeMap::from([("tetra10".to_owned(), 1)]), "{ext}");
+                if ext == "msh" {
+                    assert_eq!(data.facet_tags.len(), 4);
+                    assert_eq!(data.facet_tags[&vec![0, 1, 2]], 7);
+                }
+            }
+        }
         std::fs::remove_dir_all(dir).unwrap();
     }
 

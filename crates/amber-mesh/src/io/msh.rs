@@ -12,14 +12,16 @@
 //! `domain`, the boundary facets (and any other tagged facet) in one physical group per tag, each
 //! in an entity of its own, and the fields as `$NodeData` / `$ElementData` (NaN on the facets).
 
+use std::borrow::Cow;
 use std::collections::{BTreeMap, HashMap};
 use std::io::Write;
 use std::path::Path;
 
 use super::cursor::{Cursor, Scalar};
+use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
 use super::{MeshData, tagged_facets, write_error};
-use crate::{Mesh, MeshError};
+use crate::MeshError;
 
 /// The kind and node count of a gmsh element type.
 fn element_type(t: i64) -> Option<(Kind, usize)> {
@@ -56,6 +58,15 @@ fn element_type(t: i64) -> Option<(Kind, usize)> {
 fn simplex_type(dim: usize) -> i32 {
     [15, 1, 2, 4][dim]
 }
+
+/// The gmsh element types of the second-order simplices by dimension: point, 3-node line,
+/// 6-node triangle, 10-node tetrahedron.
+const QUADRATIC_SIMPLEX_TYPES: [i32; 4] = [15, 8, 9, 11];
+
+/// gmsh's node order of a 10-node tetrahedron, as positions in VTK's.
+const GMSH_TETRA10: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 9, 8];
+
+const IDENTITY: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9];
 
 /// The numbers of a section body: words in an ASCII file, `int` / `size_t` / `double` in a
 /// binary one.
@@ -466,7 +477,7 @@ impl<W: Write> Out<'_, W> {
 }
 
 pub(super) fn write<const D: usize>(
-    mesh: &Mesh<D>,
+    nodes: &Nodes<D>,
     data: &MeshData,
     binary: bool,
     w: &mut impl Write,
@@ -480,26 +491,27 @@ pub(super) fn write<const D: usize>(
             });
         }
     }
-    let facets = tagged_facets(mesh, data, path)?;
+    let facets = tagged_facets(nodes.mesh(), data, path)?;
     if let Some((_, tag)) = facets.iter().find(|(_, t)| *t <= 0) {
         let message = format!("facet tag {tag}: gmsh physical groups need positive tags");
         return Err(MeshError::Format { path: path.to_owned(), message });
     }
-    write_body(mesh, data, &facets, &mut Out { w, binary, first: true }).map_err(write_error(path))
+    write_body(nodes, data, &facets, &mut Out { w, binary, first: true }).map_err(write_error(path))
 }
 
-/// Node tags are 1-based vertex indices, the domain elements come first (tags 1..=n, which the
-/// data sections refer to), then the facets group by group.
+/// Node tags are 1-based node indices (the vertices, then any edge nodes), the domain elements
+/// come first (tags 1..=n, which the data sections refer to), then the facets group by group.
 fn write_body<const D: usize, W: Write>(
-    mesh: &Mesh<D>,
+    nodes: &Nodes<D>,
     data: &MeshData,
     facets: &[(Vec<u32>, i32)],
     out: &mut Out<W>,
 ) -> std::io::Result<()> {
-    let (nv, ne) = (mesh.num_vertices(), mesh.num_elements());
-    let mut groups: BTreeMap<i32, Vec<&[u32]>> = BTreeMap::new();
+    let mesh = nodes.mesh();
+    let (nv, ne) = (nodes.num_points(), mesh.num_elements());
+    let mut groups: BTreeMap<i32, Vec<Vec<u32>>> = BTreeMap::new();
     for (facet, tag) in facets {
-        groups.entry(*tag).or_default().push(facet);
+        groups.entry(*tag).or_default().push(nodes.facet(facet));
     }
     out.line("$MeshFormat")?;
     out.line(if out.binary { "4.1 1 8" } else { "4.1 0 8" })?;
@@ -566,7 +578,7 @@ fn write_body<const D: usize, W: Write>(
         out.size(tag)?;
         out.end_record()?;
     }
-    for p in mesh.vertices() {
+    for p in nodes.points() {
         out.real(p[0])?;
         out.real(p[1])?;
         out.real(if D == 3 { p[2] } else { 0.0 })?;
@@ -583,25 +595,27 @@ fn write_body<const D: usize, W: Write>(
         out.size(v)?;
     }
     out.end_record()?;
-    let block = |out: &mut Out<W>, dim: usize, entity: i32, elements: &mut dyn Iterator<Item = &[u32]>, first_tag| {
-        let elements: Vec<&[u32]> = elements.collect();
+    let quadratic = nodes.is_quadratic();
+    let block = |out: &mut Out<W>, dim: usize, entity: i32, elements: &[Vec<u32>], first_tag| {
         out.int(dim as i32)?;
         out.int(entity)?;
-        out.int(simplex_type(dim))?;
+        out.int(if quadratic { QUADRATIC_SIMPLEX_TYPES[dim] } else { simplex_type(dim) })?;
         out.size(elements.len())?;
         out.end_record()?;
-        for (k, nodes) in elements.iter().enumerate() {
+        for (k, element) in elements.iter().enumerate() {
             out.size(first_tag + k)?;
-            for &v in *nodes {
-                out.size(v as usize + 1)?;
+            // gmsh numbers a 10-node tetrahedron's last two edges 2-3, 1-3, VTK's 1-3, 2-3.
+            let order: &[usize] = if quadratic && dim == 3 { &GMSH_TETRA10 } else { &IDENTITY[..element.len()] };
+            for &i in order {
+                out.size(element[i] as usize + 1)?;
             }
             out.end_record()?;
         }
         Ok::<usize, std::io::Error>(first_tag + elements.len())
     };
-    let mut next_tag = block(out, D, 1, &mut mesh.elements(), 1)?;
+    let mut next_tag = block(out, D, 1, &nodes.elements().collect::<Vec<_>>(), 1)?;
     for (k, members) in groups.values().enumerate() {
-        next_tag = block(out, D - 1, k as i32 + 1, &mut members.iter().copied(), next_tag)?;
+        next_tag = block(out, D - 1, k as i32 + 1, members, next_tag)?;
     }
     if out.binary {
         out.line("")?;
@@ -611,7 +625,11 @@ fn write_body<const D: usize, W: Write>(
     let sections = data.point.iter().map(|f| ("NodeData", f)).chain(data.cell.iter().map(|f| ("ElementData", f)));
     for (section, (name, values)) in sections {
         // Element fields give the facets NaN: meshio rejects a field that skips elements.
-        let padding = if section == "ElementData" { facets.len() } else { 0 };
+        let (values, padding): (Cow<[f64]>, usize) = if section == "ElementData" {
+            (Cow::Borrowed(values), facets.len())
+        } else {
+            (Cow::Owned(nodes.point_field(values)), 0)
+        };
         let all = values.iter().copied().chain(std::iter::repeat_n(f64::NAN, padding));
         out.line(&format!("${section}\n1\n\"{name}\"\n1\n0.0\n3\n0\n1\n{}", values.len() + padding))?;
         for (i, v) in all.enumerate() {
@@ -630,6 +648,8 @@ fn write_body<const D: usize, W: Write>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Mesh;
+    use crate::io::ElementOrder;
     use crate::{Mesh2, Mesh3};
 
     fn parse<const D: usize>(text: &str) -> Result<(Mesh<D>, MeshData), MeshError> {
@@ -687,7 +707,7 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
 
     fn written<const D: usize>(mesh: &Mesh<D>, data: &MeshData, binary: bool) -> Vec<u8> {
         let mut bytes = Vec::new();
-        write(mesh, data, binary, &mut bytes, Path::new("x.msh")).unwrap();
+        write(&Nodes::new(mesh, ElementOrder::Linear), data, binary, &mut bytes, Path::new("x.msh")).unwrap();
         bytes
     }
 
@@ -722,9 +742,12 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
         let (back, data) = parse::<2>(&text).unwrap();
         assert_eq!(back, mesh);
         assert_eq!(data.facet_tags.len(), 3);
-        let err = write(&mesh, &MeshData::new().with_facet_tag([0, 1], 0), false, &mut Vec::new(), Path::new("x.msh"));
+        let linear = Nodes::new(&mesh, ElementOrder::Linear);
+        let err =
+            write(&linear, &MeshData::new().with_facet_tag([0, 1], 0), false, &mut Vec::new(), Path::new("x.msh"));
         assert!(err.unwrap_err().to_string().contains("positive"));
-        let err = write(&mesh, &MeshData::new().with_facet_tag([0, 7], 2), false, &mut Vec::new(), Path::new("x.msh"));
+        let err =
+            write(&linear, &MeshData::new().with_facet_tag([0, 7], 2), false, &mut Vec::new(), Path::new("x.msh"));
         assert!(err.unwrap_err().to_string().contains("[0, 7]"));
     }
 

@@ -6,16 +6,17 @@
 //! there: a file without it is truncated, and a partial mesh is never returned. Reals may use
 //! NASTRAN's implicit exponent (`-7.11-15` = -7.11e-15). GRID ids may have gaps.
 //!
-//! The writer writes free-field cards (GRID, CTETRA or CTRIA3) with coordinates in their shortest
-//! round-trip form, so a mesh reads back bit-exactly.
+//! The writer writes free-field cards (GRID, CTETRA or CTRIA3; second order: CTETRA with its six
+//! edge grids, four of them on a `+` continuation line, or CTRIA6) with coordinates in their
+//! shortest round-trip form, so a mesh reads back bit-exactly.
 
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::Path;
 
+use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
 use super::{Lines, MeshError};
-use crate::Mesh;
 
 /// The kind of an element card (a CTETRA with edge grids is found by its fields).
 fn element_card(card: &str) -> Option<Kind> {
@@ -112,15 +113,23 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     Ok(raw)
 }
 
-pub(super) fn write<const D: usize>(mesh: &Mesh<D>, w: &mut impl Write) -> std::io::Result<()> {
+pub(super) fn write<const D: usize>(nodes: &Nodes<D>, w: &mut impl Write) -> std::io::Result<()> {
     writeln!(w, "$ written by amber\nBEGIN BULK")?;
-    for (i, p) in mesh.vertices().iter().enumerate() {
+    for (i, p) in nodes.points().enumerate() {
         writeln!(w, "GRID,{},,{:?},{:?},{:?}", i + 1, p[0], p[1], if D == 3 { p[2] } else { 0.0 })?;
     }
-    let card = if D == 3 { "CTETRA" } else { "CTRIA3" };
-    for (e, cell) in mesh.elements().enumerate() {
+    let card = match (D, nodes.is_quadratic()) {
+        (2, false) => "CTRIA3",
+        (2, true) => "CTRIA6",
+        _ => "CTETRA",
+    };
+    for (e, cell) in nodes.elements().enumerate() {
         write!(w, "{card},{},1", e + 1)?;
-        for &v in cell {
+        for (k, v) in cell.iter().enumerate() {
+            // A free-field card holds eight fields after its name; a 10-node CTETRA continues.
+            if k == 6 {
+                write!(w, ",+\n+")?;
+            }
             write!(w, ",{}", v + 1)?;
         }
         writeln!(w)?;
@@ -177,6 +186,7 @@ fn real(field: &str) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::ElementOrder;
     use crate::{Mesh2, Mesh3};
 
     fn parse(text: &str) -> Result<Mesh3, MeshError> {
@@ -276,7 +286,7 @@ GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nGRID,5,,1.,1.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA
         assert_eq!(data.linearised, std::collections::BTreeMap::from([("tetra10".into(), 1)]));
         let square = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0 / 3.0, 1.0]], vec![0, 1, 2]).unwrap();
         let mut bytes = Vec::new();
-        write(&square, &mut bytes).unwrap();
+        write(&Nodes::new(&square, ElementOrder::Linear), &mut bytes).unwrap();
         assert_eq!(read(path, &bytes).unwrap().finish::<2>(path).unwrap().0, square);
     }
 

@@ -9,9 +9,10 @@ use std::io::Write;
 use std::path::Path;
 
 use super::cursor::{Cursor, Number, Scalar, as_index};
+use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
 use super::{MeshData, write_error};
-use crate::{Mesh, MeshError};
+use crate::MeshError;
 
 /// The kind of a VTK cell type code (shared with `.vtu`).
 pub(super) fn vtk_kind(code: u8) -> Option<Kind> {
@@ -239,7 +240,7 @@ fn to_indices(c: &Cursor, values: &[f64]) -> Result<Vec<u32>, MeshError> {
 }
 
 pub(super) fn write<const D: usize>(
-    mesh: &Mesh<D>,
+    nodes: &Nodes<D>,
     data: &MeshData,
     binary: bool,
     w: &mut impl Write,
@@ -251,34 +252,50 @@ pub(super) fn write<const D: usize>(
         let message = format!("field name {name:?}: legacy VTK names cannot be empty or contain whitespace");
         return Err(MeshError::Format { path: path.to_owned(), message });
     }
-    write_body(mesh, data, binary, w).map_err(write_error(path))
+    write_body(nodes, data, binary, w).map_err(write_error(path))
+}
+
+/// The VTK cell type of a simplex of `dimension`, linear or quadratic.
+pub(super) fn cell_type(dimension: usize, quadratic: bool) -> u8 {
+    match (dimension, quadratic) {
+        (2, false) => 5,
+        (2, true) => 22,
+        (_, false) => 10,
+        (_, true) => 24,
+    }
 }
 
 fn write_body<const D: usize>(
-    mesh: &Mesh<D>,
+    nodes: &Nodes<D>,
     data: &MeshData,
     binary: bool,
     w: &mut impl Write,
 ) -> std::io::Result<()> {
-    let (nv, ne) = (mesh.num_vertices(), mesh.num_elements());
+    let (np, ne, per_element) = (nodes.num_points(), nodes.mesh().num_elements(), nodes.nodes_per_element());
     let encoding = if binary { "BINARY" } else { "ASCII" };
     writeln!(w, "# vtk DataFile Version 2.0\namber mesh\n{encoding}\nDATASET UNSTRUCTURED_GRID")?;
-    writeln!(w, "POINTS {nv} double")?;
-    let points = mesh.vertices().iter().flat_map(|p| [p[0], p[1], if D == 3 { p[2] } else { 0.0 }]);
+    writeln!(w, "POINTS {np} double")?;
+    let points = nodes.points().flat_map(|p| [p[0], p[1], if D == 3 { p[2] } else { 0.0 }]);
     values(w, binary, points, 3)?;
-    writeln!(w, "CELLS {ne} {}", ne * (D + 2))?;
-    let cells = mesh.elements().flat_map(|cell| std::iter::once(D as i32 + 1).chain(cell.iter().map(|&v| v as i32)));
-    values(w, binary, cells, D + 2)?;
+    writeln!(w, "CELLS {ne} {}", ne * (per_element + 1))?;
+    let cells =
+        nodes.elements().flat_map(|cell| std::iter::once(per_element as i32).chain(cell.into_iter().map(|v| v as i32)));
+    values(w, binary, cells, per_element + 1)?;
     writeln!(w, "CELL_TYPES {ne}")?;
-    values(w, binary, std::iter::repeat_n(if D == 2 { 5i32 } else { 10 }, ne), 1)?;
-    for (section, n, fields) in [("CELL_DATA", ne, &data.cell), ("POINT_DATA", nv, &data.point)] {
-        if !fields.is_empty() {
-            writeln!(w, "{section} {n}")?;
-        }
-        for (name, field) in fields {
-            writeln!(w, "SCALARS {name} {} 1\nLOOKUP_TABLE default", f64::LEGACY)?;
-            values(w, binary, field.iter().copied(), 1)?;
-        }
+    values(w, binary, std::iter::repeat_n(i32::from(cell_type(D, nodes.is_quadratic())), ne), 1)?;
+    if !data.cell.is_empty() {
+        writeln!(w, "CELL_DATA {ne}")?;
+    }
+    for (name, field) in &data.cell {
+        writeln!(w, "SCALARS {name} {} 1\nLOOKUP_TABLE default", f64::LEGACY)?;
+        values(w, binary, field.iter().copied(), 1)?;
+    }
+    if !data.point.is_empty() {
+        writeln!(w, "POINT_DATA {np}")?;
+    }
+    for (name, field) in &data.point {
+        writeln!(w, "SCALARS {name} {} 1\nLOOKUP_TABLE default", f64::LEGACY)?;
+        values(w, binary, nodes.point_field(field).into_iter(), 1)?;
     }
     Ok(())
 }
@@ -308,6 +325,8 @@ fn values<T: Number>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Mesh;
+    use crate::io::ElementOrder;
     use crate::{Mesh2, Mesh3};
 
     fn parse<const D: usize>(bytes: &[u8]) -> Result<(Mesh<D>, MeshData), MeshError> {
@@ -325,11 +344,16 @@ mod tests {
         let data = MeshData::new().with_cell("h", vec![0.1 + 0.2]).with_point("u", vec![1.0, 2.0, 3.0, -0.5]);
         for binary in [false, true] {
             let mut bytes = Vec::new();
-            write(&mesh, &data, binary, &mut bytes, Path::new("x.vtk")).unwrap();
+            write(&Nodes::new(&mesh, ElementOrder::Linear), &data, binary, &mut bytes, Path::new("x.vtk")).unwrap();
             assert_eq!(parse::<3>(&bytes).unwrap(), (mesh.clone(), data.clone()));
         }
-        let err =
-            write(&mesh, &MeshData::new().with_cell("a b", vec![1.0]), false, &mut Vec::new(), Path::new("x.vtk"));
+        let err = write(
+            &Nodes::new(&mesh, ElementOrder::Linear),
+            &MeshData::new().with_cell("a b", vec![1.0]),
+            false,
+            &mut Vec::new(),
+            Path::new("x.vtk"),
+        );
         assert!(err.unwrap_err().to_string().contains("whitespace"));
     }
 
@@ -350,7 +374,14 @@ CELL_TYPES 2\n3\n5\n\nCELL_DATA 2\nFIELD FieldData 1\nsize 1 2 double\n7 0.5\nME
     fn malformed_files_name_the_line_or_byte() {
         let mesh = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], vec![0, 1, 2]).unwrap();
         let mut bytes = Vec::new();
-        write(&mesh, &MeshData::new().with_cell("h", vec![1.0]), true, &mut bytes, Path::new("x.vtk")).unwrap();
+        write(
+            &Nodes::new(&mesh, ElementOrder::Linear),
+            &MeshData::new().with_cell("h", vec![1.0]),
+            true,
+            &mut bytes,
+            Path::new("x.vtk"),
+        )
+        .unwrap();
         for cut in 0..bytes.len() - 1 {
             if let Err(err) = parse::<2>(&bytes[..cut]) {
                 assert!(err.to_string().starts_with("inline.vtk"), "{err}");

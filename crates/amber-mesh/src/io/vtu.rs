@@ -16,10 +16,11 @@ use base64::Engine;
 use quick_xml::events::{BytesStart, Event};
 
 use super::cursor::{Number, Scalar, as_index};
+use super::nodes::Nodes;
 use super::raw::RawMesh;
-use super::vtk::vtk_kind;
+use super::vtk::{cell_type, vtk_kind};
 use super::{Encoding, MeshData};
-use crate::{Mesh, MeshError};
+use crate::MeshError;
 
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Section {
@@ -337,35 +338,37 @@ fn block(bytes: &[u8], header: &Header) -> Result<Vec<u8>, String> {
 }
 
 pub(super) fn write<const D: usize>(
-    mesh: &Mesh<D>,
+    nodes: &Nodes<D>,
     data: &MeshData,
     binary: bool,
     w: &mut impl Write,
 ) -> std::io::Result<()> {
     let encoding = if binary { Encoding::Binary } else { Encoding::Ascii };
-    let (nv, ne) = (mesh.num_vertices(), mesh.num_elements());
+    let (np, ne, per_element) = (nodes.num_points(), nodes.mesh().num_elements(), nodes.nodes_per_element());
     writeln!(w, "<?xml version=\"1.0\"?>")?;
     writeln!(
         w,
         "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
     )?;
-    writeln!(w, "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{nv}\" NumberOfCells=\"{ne}\">")?;
-    for (tag, fields) in [("PointData", &data.point), ("CellData", &data.cell)] {
-        writeln!(w, "<{tag}>")?;
-        for (name, values) in fields {
-            data_array(w, name, 1, values, encoding)?;
-        }
-        writeln!(w, "</{tag}>")?;
+    writeln!(w, "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{ne}\">")?;
+    writeln!(w, "<PointData>")?;
+    for (name, values) in &data.point {
+        data_array(w, name, 1, &nodes.point_field(values), encoding)?;
     }
-    let points: Vec<f64> = mesh.vertices().iter().flat_map(|p| [p[0], p[1], if D == 3 { p[2] } else { 0.0 }]).collect();
+    writeln!(w, "</PointData>\n<CellData>")?;
+    for (name, values) in &data.cell {
+        data_array(w, name, 1, values, encoding)?;
+    }
+    writeln!(w, "</CellData>")?;
+    let points: Vec<f64> = nodes.points().flat_map(|p| [p[0], p[1], if D == 3 { p[2] } else { 0.0 }]).collect();
     writeln!(w, "<Points>")?;
     data_array(w, "Points", 3, &points, encoding)?;
     writeln!(w, "</Points>\n<Cells>")?;
-    let connectivity: Vec<i64> = mesh.cells().iter().map(|&v| i64::from(v)).collect();
-    let offsets: Vec<i64> = (1..=ne as i64).map(|e| e * (D as i64 + 1)).collect();
+    let connectivity: Vec<i64> = nodes.elements().flatten().map(i64::from).collect();
+    let offsets: Vec<i64> = (1..=ne as i64).map(|e| e * per_element as i64).collect();
     data_array(w, "connectivity", 1, &connectivity, encoding)?;
     data_array(w, "offsets", 1, &offsets, encoding)?;
-    data_array(w, "types", 1, &vec![if D == 2 { 5u8 } else { 10 }; ne], encoding)?;
+    data_array(w, "types", 1, &vec![cell_type(D, nodes.is_quadratic()); ne], encoding)?;
     writeln!(w, "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>")
 }
 
@@ -404,7 +407,9 @@ fn data_array<T: Number>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Mesh;
     use crate::Mesh2;
+    use crate::io::ElementOrder;
 
     fn square() -> Mesh2 {
         Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![0, 1, 2, 0, 2, 3]).unwrap()
@@ -412,7 +417,7 @@ mod tests {
 
     fn to_text<const D: usize>(mesh: &Mesh<D>, data: &MeshData, binary: bool) -> String {
         let mut bytes = Vec::new();
-        write(mesh, data, binary, &mut bytes).unwrap();
+        write(&Nodes::new(mesh, ElementOrder::Linear), data, binary, &mut bytes).unwrap();
         String::from_utf8(bytes).unwrap()
     }
 
