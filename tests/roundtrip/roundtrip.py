@@ -256,25 +256,30 @@ def meshio_read(path):
     return meshio.read(path, file_format="gmsh" if path.endswith(".msh") else None)
 
 
-def read_with_meshio(path, dim, points, cells, size, has_data, physical):
+def meshio_elements(path, kind):
+    """meshio's mesh of `path`, its points in 3D and its elements of `kind`."""
     m = meshio_read(path)
-    got = np.concatenate([c.data for c in m.cells if c.type == SIMPLEX[dim]])
+    got = np.concatenate([c.data for c in m.cells if c.type == kind])
     got_points = np.zeros((len(m.points), 3))
     got_points[:, : m.points.shape[1]] = m.points
+    return m, got_points, got
+
+
+def same_size_field(m, kind, size):
+    blocks = [np.ravel(d) for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == kind]
+    same_values(size, np.concatenate(blocks) if blocks else None, "cell data `size`")
+
+
+def read_with_meshio(path, dim, points, cells, size, has_data, physical):
+    m, got_points, got = meshio_elements(path, SIMPLEX[dim])
     same_points(points, got_points)
     same_cells(points, cells, got_points, got)
     if has_data:
-        blocks = [np.ravel(d) for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == SIMPLEX[dim]]
-        same_values(size, np.concatenate(blocks) if blocks else None, "cell data `size`")
+        same_size_field(m, SIMPLEX[dim], size)
     if physical and not {"domain", "boundary"} <= set(m.field_data):
         raise AssertionError(f"physical names {sorted(m.field_data)}")
     if path.endswith(".inp"):
-        # The boundary's node set: the vertices of the facets that one element alone has.
-        faces = [tuple(sorted(np.delete(c, k))) for c in np.asarray(cells).tolist() for k in range(dim + 1)]
-        counts = {}
-        for f in faces:
-            counts[f] = counts.get(f, 0) + 1
-        boundary = sorted({v for f, n in counts.items() if n == 1 for v in f})
+        boundary = sorted({v for f in boundary_facets(cells, dim) for v in f})
         if "boundary" not in m.point_sets:
             raise AssertionError(f"node sets {sorted(m.point_sets)}")
         same_points(np.asarray(points)[boundary], got_points[np.asarray(m.point_sets["boundary"])])
@@ -320,14 +325,10 @@ def read_quadratic_with_meshio(path, dim, points, cells, size, has_data):
         path = path[: -len(".inp")] + "-cpe6.inp"
         with open(path, "w") as f:
             f.write(text.replace("TYPE=CPS6", "TYPE=CPE6"))
-    m = meshio_read(path)
-    got = np.concatenate([c.data for c in m.cells if c.type == QUADRATIC[dim]])
-    got_points = np.zeros((len(m.points), 3))
-    got_points[:, : m.points.shape[1]] = m.points
+    m, got_points, got = meshio_elements(path, QUADRATIC[dim])
     same_quadratic(points, cells, got_points, got, EDGES["vtk"][dim])
     if has_data:
-        blocks = [np.ravel(d) for c, d in zip(m.cells, m.cell_data.get("size", [])) if c.type == QUADRATIC[dim]]
-        same_values(size, np.concatenate(blocks) if blocks else None, "cell data `size`")
+        same_size_field(m, QUADRATIC[dim], size)
     if path.endswith(".inp"):
         # The boundary's node set holds the edge nodes of the boundary facets too.
         facets = boundary_facets(cells, dim)
@@ -337,18 +338,24 @@ def read_quadratic_with_meshio(path, dim, points, cells, size, has_data):
         same_points(np.vstack([corners, sorted(midpoints)]), got_points[np.asarray(m.point_sets["boundary"])])
 
 
-def read_quadratic_with_gmsh(path, dim, points, cells):
+def gmsh_elements(path, dim, types, nodes_per_element):
+    """gmsh's nodes of `path` and its elements of dimension `dim` and of the gmsh `types`."""
     restart_gmsh()
     gmsh.open(path)
     tags, coords, _ = gmsh.model.mesh.getNodes()
     got_points = np.asarray(coords).reshape(-1, 3)
     index = {t: i for i, t in enumerate(tags)}
-    types, _, nodes = gmsh.model.mesh.getElements(dim)
-    blocks = [n for t, n in zip(types, nodes) if t in (9, 11)]
+    found, _, nodes = gmsh.model.mesh.getElements(dim)
+    blocks = [n for t, n in zip(found, nodes) if t in types]
     if not blocks:
-        raise AssertionError(f"element types {list(types)}, no second-order simplices")
-    got = np.array([index[t] for t in np.concatenate(blocks)]).reshape(-1, len(EDGES["gmsh"][dim]) + dim + 1)
-    same_quadratic(points, cells, got_points, got, EDGES["gmsh"][dim])
+        raise AssertionError(f"element types {list(found)}, none of {types}")
+    return got_points, np.array([index[t] for t in np.concatenate(blocks)]).reshape(-1, nodes_per_element)
+
+
+def read_quadratic_with_gmsh(path, dim, points, cells):
+    edges = EDGES["gmsh"][dim]
+    got_points, got = gmsh_elements(path, dim, (9, 11), dim + 1 + len(edges))
+    same_quadratic(points, cells, got_points, got, edges)
 
 
 def restart_gmsh():
@@ -360,16 +367,9 @@ def restart_gmsh():
 
 
 def read_with_gmsh(path, dim, points, cells, physical):
-    restart_gmsh()
-    gmsh.open(path)
-    tags, coords, _ = gmsh.model.mesh.getNodes()
-    got_points = np.asarray(coords).reshape(-1, 3)
-    index = {t: i for i, t in enumerate(tags)}
-    types, _, nodes = gmsh.model.mesh.getElements(dim)
-    simplex = [n for t, n in zip(types, nodes) if t in (2, 4)]
-    got = np.array([index[t] for t in np.concatenate(simplex)] if simplex else [], dtype=int).reshape(-1, dim + 1)
+    got_points, got = gmsh_elements(path, dim, (2, 4), dim + 1)
     same_points(points, got_points)
-    same_cells(points, cells, got_points, got.astype(int))
+    same_cells(points, cells, got_points, got)
     if physical:
         groups = set(gmsh.model.getPhysicalGroups())
         if not {(dim, 1), (dim - 1, 1)} <= groups:

@@ -176,18 +176,13 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
         r#"{"outer": [[0,0],[1,0],[1,1],[0,1]], "holes": [[[0.4,0.4],[0.4,0.6],[0.6,0.6],[0.6,0.4]]]}"#,
     )
     .unwrap();
+    let mesh_square = |knobs: &[&str]| {
+        let mut command = amber();
+        command.arg("mesh").arg(&square).args(["--steps", "2"]).args(knobs).arg("--model").arg(&run);
+        command.arg("--problem").arg(&problem_file).arg("-o").arg(&final_mesh).output().unwrap()
+    };
     for elements in [300usize, 1200] {
-        let output = amber()
-            .arg("mesh")
-            .arg(&square)
-            .args(["--steps", "2", "--elements", &elements.to_string(), "--model"])
-            .arg(&run)
-            .arg("--problem")
-            .arg(&problem_file)
-            .arg("-o")
-            .arg(&final_mesh)
-            .output()
-            .unwrap();
+        let output = mesh_square(&["--elements", &elements.to_string()]);
         assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
         let mesh = amber_mesh::read_mesh::<2>(&final_mesh).unwrap();
         let ratio = mesh.num_elements() as f64 / elements as f64;
@@ -198,17 +193,7 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
     // The size range: a range of one size makes the model's field uniform; an empty range is an
     // error naming the flags.
     for (bounds, ok) in [(["0.05", "0.05"], true), (["0.05", "0.01"], false)] {
-        let output = amber()
-            .arg("mesh")
-            .arg(&square)
-            .args(["--steps", "2", "--min-size", bounds[0], "--max-size", bounds[1], "--model"])
-            .arg(&run)
-            .arg("--problem")
-            .arg(&problem_file)
-            .arg("-o")
-            .arg(&final_mesh)
-            .output()
-            .unwrap();
+        let output = mesh_square(&["--min-size", bounds[0], "--max-size", bounds[1]]);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.success(), ok, "{bounds:?}: {stderr}");
         if !ok {
