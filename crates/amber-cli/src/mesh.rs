@@ -10,13 +10,16 @@ use amber_mesh::{
     write_mesh, write_mesh_as,
 };
 use amber_meshgen::mesh3d::{Mesh3dParams, SurfaceDistance, generate_3d};
-use amber_meshgen::{ConstantSize, Mesh2dParams, MeshSizing, PolygonDomain, QualityReport, SizingField, generate_2d};
+use amber_meshgen::{
+    ConstantSize, Mesh2dParams, MeshSizing, PolygonDistance, PolygonDomain, QualityReport, SizingField, generate_2d,
+};
 use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
 use amber_stdx::quantile;
 use amber_tasks::cad::is_cad;
 use amber_tasks::part::{
-    FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, cad_face_tags, read_polygon_domain, read_solid_surface,
+    FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, cad_face_tags, polygon_side_tags, read_polygon_domain,
+    read_solid_surface,
 };
 use amber_tasks::poisson::{PoissonPart, read_part};
 use amber_tasks::{Domain, SizeBounds, WithExpert};
@@ -371,7 +374,8 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
         }
     };
     let seconds = start.elapsed().as_secs_f64();
-    write_output(&mesh, args, MeshData::new())?;
+    let facet_tags = polygon_side_tags(&PolygonDistance::new(&domain), &mesh);
+    write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
     eprintln!(
         "{} triangles in {seconds:.3} s; size ratio median {:.3} (p10 {:.3}, p90 {:.3}); mean smallest angle {:.1}°; wrote {}",
         mesh.num_elements(),

@@ -22,9 +22,14 @@ fn meshes_an_lshape_and_remeshes_from_the_result() {
     let status =
         amber().args(["mesh", "--corner", "0.3,0.6", "--size"]).arg(&first).arg("-o").arg(&second).status().unwrap();
     assert!(status.success());
-    let remeshed = amber_mesh::read_mesh::<2>(&second).unwrap();
+    let (remeshed, data) = amber_mesh::read_mesh_with_data::<2>(&second).unwrap();
     let ratio = remeshed.num_elements() as f64 / mesh.num_elements() as f64;
     assert!((0.8..1.25).contains(&ratio), "{ratio}");
+    // One physical group per side of the L-shape, over every boundary edge.
+    let groups: std::collections::BTreeSet<i32> = data.facet_tags.values().copied().collect();
+    assert_eq!(groups.len(), 6, "{groups:?}");
+    let boundary_edges = amber_mesh::FacetAdjacency::new(&remeshed).unwrap().boundary_facets().count();
+    assert_eq!(data.facet_tags.len(), boundary_edges);
 
     let picture = dir.path().join("mesh.png");
     assert!(amber().args(["mesh", "--size", "0.1", "-o"]).arg(&picture).status().unwrap().success());

@@ -247,11 +247,21 @@ impl PolygonDomain {
 #[derive(Clone, Debug)]
 pub struct PolygonDistance {
     /// Every boundary edge with the boundary's radius of curvature there (see
-    /// [`PolygonDistance::to_boundary`]).
-    edges: RTree<GeomWithData<Line<[f64; 2]>, f64>>,
+    /// [`PolygonDistance::to_boundary`]) and the side it belongs to (see
+    /// [`PolygonDistance::nearest_side`]).
+    edges: RTree<GeomWithData<Line<[f64; 2]>, EdgeData>>,
     /// The vertices where the boundary turns by more than [`CORNER_TURN`], each with its turn
     /// (positive where the domain is convex, negative at a re-entrant corner).
     corners: RTree<GeomWithData<[f64; 2], f64>>,
+}
+
+/// What [`PolygonDistance`] knows of a boundary edge.
+#[derive(Clone, Copy, Debug)]
+struct EdgeData {
+    /// The boundary's radius of curvature along the edge.
+    radius: f64,
+    /// The side of the boundary the edge belongs to.
+    side: i32,
 }
 
 /// The smallest turn of the boundary that makes a vertex a corner: a polygon that approximates
@@ -264,29 +274,40 @@ impl PolygonDistance {
         let outer_sign = ring_area(domain.outer()).signum();
         let mut edges = Vec::new();
         let mut corners = Vec::new();
+        let mut sides = 0i32;
         for (r, ring) in domain.rings().enumerate() {
             // Walking with the domain on the left: the outer ring anticlockwise, holes clockwise.
             let sign = if r == 0 { outer_sign } else { -ring_area(ring).signum() };
             let n = ring.len();
-            // The curvature at each vertex of a smooth stretch: its turn over the mean length of
-            // its two edges (1/r on a polygon inscribed in a circle of radius r); corners are
-            // features, not curvature.
-            let curvature: Vec<f64> = (0..n)
+            let turns: Vec<f64> = (0..n)
                 .map(|i| {
                     let (prev, v, next) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
                     let (a, b) = ([v[0] - prev[0], v[1] - prev[1]], [next[0] - v[0], next[1] - v[1]]);
-                    let turn = sign * (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
-                    if turn.abs() > CORNER_TURN {
-                        corners.push(GeomWithData::new(v, turn));
-                        return 0.0;
-                    }
-                    2.0 * turn.abs() / (a[0].hypot(a[1]) + b[0].hypot(b[1]))
+                    sign * (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1])
                 })
                 .collect();
-            for i in 0..n {
+            let is_corner = |i: usize| turns[i].abs() > CORNER_TURN;
+            corners.extend((0..n).filter(|&i| is_corner(i)).map(|i| GeomWithData::new(ring[i], turns[i])));
+            // The curvature at each vertex of a smooth stretch: its turn over the mean length of
+            // its two edges (1/r on a polygon inscribed in a circle of radius r); corners are
+            // features, not curvature.
+            let length = |i: usize| (ring[(i + 1) % n][0] - ring[i][0]).hypot(ring[(i + 1) % n][1] - ring[i][1]);
+            let curvature: Vec<f64> = (0..n)
+                .map(|i| if is_corner(i) { 0.0 } else { 2.0 * turns[i].abs() / (length((i + n - 1) % n) + length(i)) })
+                .collect();
+            // A side runs from corner to corner, a ring without corners is one side: numbered
+            // from the ring's first corner, so that the side through vertex 0 is one side.
+            let first = (0..n).find(|&i| is_corner(i)).unwrap_or(0);
+            let mut side = sides;
+            for k in 0..n {
+                let i = (first + k) % n;
+                if k == 0 || is_corner(i) {
+                    side += 1;
+                }
                 let radius = 1.0 / curvature[i].max(curvature[(i + 1) % n]);
-                edges.push(GeomWithData::new(Line::new(ring[i], ring[(i + 1) % n]), radius));
+                edges.push(GeomWithData::new(Line::new(ring[i], ring[(i + 1) % n]), EdgeData { radius, side }));
             }
+            sides = side;
         }
         Self { edges: RTree::bulk_load(edges), corners: RTree::bulk_load(corners) }
     }
@@ -295,7 +316,17 @@ impl PolygonDistance {
     /// boundary point nearest to `p`: of the circle through the smooth (non-corner) vertices
     /// there, infinite along straight edges.
     pub fn to_boundary(&self, p: [f64; 2]) -> (f64, f64) {
-        self.edges.nearest_neighbor(p).map_or((f64::INFINITY, f64::INFINITY), |e| (e.distance_2(&p).sqrt(), e.data))
+        self.edges
+            .nearest_neighbor(p)
+            .map_or((f64::INFINITY, f64::INFINITY), |e| (e.distance_2(&p).sqrt(), e.data.radius))
+    }
+
+    /// The side of the boundary nearest to `p`: sides are the stretches of a ring between its
+    /// corners (a ring without corners is one side), numbered from 1 along the outer ring from
+    /// its first corner, then along each hole; `None` for an empty domain. The 2D counterpart of
+    /// a solid's CAD faces, for boundary conditions.
+    pub fn nearest_side(&self, p: [f64; 2]) -> Option<i32> {
+        self.edges.nearest_neighbor(p).map(|e| e.data.side)
     }
 
     /// The distance from `p` to the nearest corner and how far the boundary turns there (in
@@ -486,6 +517,16 @@ mod tests {
         }
         assert!(distance.to_corner([0.62, 0.5]).unwrap().0 > 0.3, "a 48-gon has no corners");
         assert_eq!(distance.to_boundary([0.5, 0.05]), (0.05, f64::INFINITY));
+        // Sides: the square's four from its first corner, then the hole, one side all round.
+        let sides = [[0.5, 0.02], [0.98, 0.5], [0.5, 0.98], [0.02, 0.5], [0.65, 0.5], [0.5, 0.35], [0.42, 0.55]];
+        let found: Vec<i32> = sides.iter().map(|&p| distance.nearest_side(p).unwrap()).collect();
+        assert_eq!(found, [1, 2, 3, 4, 5, 5, 5]);
+        // A ring that starts in the middle of a side still has that side once.
+        let outer = vec![[0.5, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.0, 0.0]];
+        let distance = PolygonDistance::new(&PolygonDomain::new(outer, vec![]).unwrap());
+        let found: Vec<i32> = sides[..4].iter().map(|&p| distance.nearest_side(p).unwrap()).collect();
+        assert_eq!(found, [4, 1, 2, 3]);
+        assert_eq!(distance.nearest_side([0.8, 0.01]), Some(4));
     }
 
     /// The L-shape turns a quarter left at its five convex corners and a quarter right at the

@@ -286,14 +286,31 @@ impl Domain<3> for SolidPart {
 /// surface vertex on its own face and every triangle within one face, so this is the face it
 /// was made on. Empty for a mesh whose facets do not pair up (not a generated mesh).
 pub fn cad_face_tags(distance: &SurfaceDistance, mesh: &Mesh3) -> BTreeMap<Vec<u32>, i32> {
+    boundary_facet_tags(mesh, |centroid| distance.nearest_face(centroid))
+}
+
+/// Every boundary edge of `mesh` (a mesh of the polygon `distance` measures), keyed by its sorted
+/// vertices, tagged with the side of the polygon nearest its midpoint
+/// ([`PolygonDistance::nearest_side`]: the stretches between corners). The generator splits the
+/// polygon's edges, so each mesh edge lies on one side. Empty as [`cad_face_tags`].
+pub fn polygon_side_tags(distance: &PolygonDistance, mesh: &Mesh2) -> BTreeMap<Vec<u32>, i32> {
+    boundary_facet_tags(mesh, |midpoint| distance.nearest_side(midpoint))
+}
+
+/// The boundary facets of `mesh`, keyed by their sorted vertices, tagged by `piece` of their
+/// centroids.
+fn boundary_facet_tags<const D: usize>(
+    mesh: &Mesh<D>,
+    piece: impl Fn([f64; D]) -> Option<i32> + Sync,
+) -> BTreeMap<Vec<u32>, i32> {
     let Ok(adjacency) = FacetAdjacency::new(mesh) else { return BTreeMap::new() };
     let vertices = mesh.vertices();
     (adjacency.oriented_boundary_facets(mesh).par_iter())
         .filter_map(|facet| {
-            let centroid = amber_mesh::centroid::<3>(vertices, facet);
+            let centroid = amber_mesh::centroid::<D>(vertices, facet);
             let mut key = facet.to_vec();
             key.sort_unstable();
-            distance.nearest_face(centroid).map(|face| (key, face))
+            piece(centroid).map(|tag| (key, tag))
         })
         .collect()
 }
@@ -375,6 +392,10 @@ impl Domain<2> for PlanarPart {
         let params = Mesh2dParams::default().with_max_elements(max_elements);
         Ok(generate_2d(&self.domain, &MeshSizing::new(mesh, sizes), &params)?)
     }
+
+    fn boundary_tags(&self, mesh: &Mesh<2>) -> BTreeMap<Vec<u32>, i32> {
+        polygon_side_tags(&self.geometry.distance, mesh)
+    }
 }
 
 #[cfg(test)]
@@ -382,6 +403,26 @@ mod tests {
     use std::f64::consts::FRAC_PI_2;
 
     use super::*;
+
+    /// The L-shape meshed: every boundary edge is tagged with one of its six sides, and each
+    /// side's edges lie on one line.
+    #[test]
+    fn boundary_edges_are_tagged_with_their_side_of_the_polygon() {
+        let part = PlanarPart::new("l".into(), PolygonDomain::lshape([0.4, 0.6]).unwrap(), 0.05).unwrap();
+        let mesh = &part.initial_mesh;
+        let tags = part.boundary_tags(mesh);
+        assert_eq!(tags.len(), FacetAdjacency::new(mesh).unwrap().boundary_facets().count());
+        let mut sides: BTreeMap<i32, Vec<[f64; 2]>> = BTreeMap::new();
+        for (edge, tag) in &tags {
+            sides.entry(*tag).or_default().extend(edge.iter().map(|&v| mesh.vertices()[v as usize]));
+        }
+        assert_eq!(sides.keys().copied().collect::<Vec<_>>(), [1, 2, 3, 4, 5, 6]);
+        for points in sides.values() {
+            let (a, b) = (points[0], points[1]);
+            let off_line = |p: &[f64; 2]| ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])).abs();
+            assert!(points.iter().all(|p| off_line(p) < 1e-12), "{points:?}");
+        }
+    }
 
     /// A cube of six CAD faces, meshed: every boundary triangle is tagged with the face it lies
     /// on (the coordinate that is 0 or 1 across its corners says which).

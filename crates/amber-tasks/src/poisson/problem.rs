@@ -3,13 +3,17 @@
 //! [`PoissonPart`] is the same task on any polygon with holes and without an expert: what a
 //! trained Poisson model meshes.
 
+use std::collections::BTreeMap;
+
 use amber_fem::{ExpertHeuristic, GaussianMixture, Load, P1Space, Quadrature, element_stats};
 use amber_graph::FeatureSet;
 use amber_mesh::{Mesh, Mesh2};
-use amber_meshgen::{Mesh2dParams, MeshSizing, MeshgenError, PolygonDomain, generate_2d, uniform_mesh_2d};
+use amber_meshgen::{
+    Mesh2dParams, MeshSizing, MeshgenError, PolygonDistance, PolygonDomain, generate_2d, uniform_mesh_2d,
+};
 
 use super::{INITIAL_SIZE, PoissonProblem};
-use crate::part::{GEOMETRY_INPUTS, PlanarGeometry};
+use crate::part::{GEOMETRY_INPUTS, PlanarGeometry, polygon_side_tags};
 use crate::problem::{Column, Domain, Problem, ProblemError};
 
 /// Name of the optional input ln η_K: the residual error indicator of the current solution, the
@@ -119,6 +123,10 @@ impl Domain<2> for PoissonPart {
 
     fn remesh(&self, mesh: &Mesh<2>, sizes: Vec<f64>, max_elements: usize) -> Result<Mesh<2>, ProblemError> {
         remesh_polygon(&self.domain, mesh, sizes, max_elements)
+    }
+
+    fn boundary_tags(&self, mesh: &Mesh<2>) -> BTreeMap<Vec<u32>, i32> {
+        polygon_side_tags(&PolygonDistance::new(&self.domain), mesh)
     }
 }
 
