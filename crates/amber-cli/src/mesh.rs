@@ -134,7 +134,8 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             let path = Path::new(geometry);
             let surface = read_solid_surface(path, args.feature_angle, card.initial_size)?;
             let mut part = SolidPart::new(part_name(geometry), surface, card.initial_size)
-                .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
+                .with_context(|| initial_mesh_failed(geometry, card.initial_size))?;
+            check_initial_mesh(&part.initial_mesh, card.initial_size);
             part.inputs = part_inputs(args)?;
             let expert = args.expert.as_ref().map(|p| read_mesh::<3>(p).map(|m| (m, p.clone()))).transpose()?;
             mesh_domain(args, &trained, part, expert, steps)
@@ -142,7 +143,8 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
         Task::Folder { dimension: 2 } => {
             let geometry = args.geometry.as_deref().unwrap_or("lshape");
             let mut part = PlanarPart::new(part_name(geometry), planar_domain(args)?, card.initial_size)
-                .with_context(|| format!("{geometry}: cannot mesh the initial mesh M⁰"))?;
+                .with_context(|| initial_mesh_failed(geometry, card.initial_size))?;
+            check_initial_mesh(&part.initial_mesh, card.initial_size);
             part.inputs = part_inputs(args)?;
             let expert = args.expert.as_ref().map(|p| read_mesh::<2>(p).map(|m| (m, p.clone()))).transpose()?;
             mesh_domain(args, &trained, part, expert, steps)
@@ -156,6 +158,38 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
 /// The part's own inputs of `--problem` (none without it).
 fn part_inputs<const D: usize>(args: &MeshArgs) -> anyhow::Result<PartInputs<D>> {
     Ok(args.problem.as_deref().map(PartInputs::read).transpose()?.unwrap_or_default())
+}
+
+/// M⁰'s median element size below this fraction of the model's initial size h0 says that the
+/// part is far smaller than the parts the model learned from (theirs have medians near 0.8 h0): most
+/// likely it is in other units.
+const SMALL_INITIAL_MESH: f64 = 0.25;
+
+/// Why M⁰ of `geometry` may have failed, the part being in other units than the model's.
+fn initial_mesh_failed(geometry: &str, initial_size: f64) -> String {
+    format!(
+        "{geometry}: cannot mesh the initial mesh M⁰ at the model's initial size {initial_size} \
+         (is the geometry in the units of the model's training parts?)"
+    )
+}
+
+/// Says how many elements M⁰ has and how large, with a warning when they are much smaller than
+/// the model's initial size.
+fn check_initial_mesh<const D: usize>(initial_mesh: &Mesh<D>, initial_size: f64) {
+    let mut sizes = initial_mesh.sizes();
+    sizes.sort_by(f64::total_cmp);
+    let median = quantile(&sizes, 0.5);
+    eprintln!(
+        "M⁰: {} elements of median size {median:.4} at the model's initial size {initial_size}",
+        initial_mesh.num_elements()
+    );
+    if median < SMALL_INITIAL_MESH * initial_size {
+        eprintln!(
+            "warning: the part is small for this model: M⁰'s elements are {:.1e} of the model's initial size. Is \
+             the geometry in the units of the model's training parts?",
+            median / initial_size
+        );
+    }
 }
 
 /// What reports call a part: the geometry file's stem.
@@ -328,7 +362,7 @@ where
     );
     if degenerate > 0 {
         eprintln!(
-            "warning: {degenerate} of {} elements have an {angle} below {DEGENERATE_ANGLE_DEGREES}° (nearly degenerate)",
+            "warning: {degenerate} of {} elements are nearly degenerate, their smallest {angle} below {DEGENERATE_ANGLE_DEGREES}°",
             mesh.num_elements()
         );
     }

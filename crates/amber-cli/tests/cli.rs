@@ -330,6 +330,16 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     let field = &cells.cell["log_size_ratio_to_expert"];
     let expected = amber_metrics::log_size_ratios(&generated, &expert);
     assert!(field.iter().zip(&expected).all(|(a, b)| (a - b).abs() < 1e-9) && field.len() == expected.len());
+    assert!(!String::from_utf8_lossy(&output.stderr).contains("units"));
+
+    // The same plate in units a thousand times larger than the model's: meshed, with a warning.
+    let shrunk = dir.path().join("shrunk.vtu");
+    let scaled: Vec<[f64; 2]> = expert.vertices().iter().map(|p| [p[0] * 1e-3, p[1] * 1e-3]).collect();
+    let tiny = amber_mesh::Mesh2::new(scaled, expert.cells().to_vec()).unwrap();
+    amber_mesh::write_mesh(&tiny, &shrunk, &amber_mesh::MeshData::new()).unwrap();
+    let output = amber().arg("mesh").arg(&shrunk).arg("--model").arg(&run).arg("-o").arg(&mesh).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success() && stderr.contains("in the units of the model's training parts"), "{stderr}");
 
     // A 2D model on a folder of tet meshes is an error naming both.
     let solids = dir.path().join("solids");
