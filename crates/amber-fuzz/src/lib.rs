@@ -15,7 +15,10 @@ pub use train::{model_dir, training_config};
 
 use std::path::{Path, PathBuf};
 
-use amber_mesh::{AnyMesh, Mesh, StlFaceIds, parse_any_mesh, parse_surface};
+use amber_mesh::{
+    AnyMesh, ElementOrder, Mesh, MeshData, StlFaceIds, WriteOptions, parse_any_mesh, parse_surface,
+    read_mesh_with_data, write_mesh_as,
+};
 use amber_meshgen::mesh3d::{Mesh3dParams, Surface, generate_3d};
 use amber_meshgen::{ConstantSize, Mesh2dParams, PolygonDomain, uniform_mesh_2d};
 
@@ -38,20 +41,23 @@ const MESH_EXTENSIONS: [&str; 7] = ["msh", "vtu", "vtk", "nas", "inp", "mesh", "
 /// Meshes made by the targets stay this small, so that an input runs in milliseconds.
 pub(crate) const ELEMENT_CAP: usize = 20_000;
 
-/// A mesh file: the first byte picks the format, the rest is the file. A mesh read is checked
-/// and its boundary made into a geometry (as a folder dataset without geometry files does).
+/// A mesh file: the first byte picks the format, the rest is the file. A mesh read is checked,
+/// written back in every format and element order, and its boundary made into a geometry (as a
+/// folder dataset without geometry files does).
 pub fn mesh_file(data: &[u8]) {
     let Some((&format, contents)) = data.split_first() else { return };
     let path = format!("fuzz.{}", MESH_EXTENSIONS[format as usize % MESH_EXTENSIONS.len()]);
     match parse_any_mesh(Path::new(&path), contents.to_vec()) {
-        Ok(AnyMesh::Two(mesh, _)) => {
+        Ok(AnyMesh::Two(mesh, data)) => {
             assert_valid(&mesh);
+            assert_written_back(&mesh, &data);
             if let Ok(domain) = PolygonDomain::from_mesh_boundary(&mesh) {
                 assert!(domain.area() > 0.0 && domain.area().is_finite(), "area {}", domain.area());
             }
         }
-        Ok(AnyMesh::Three(mesh, _)) => {
+        Ok(AnyMesh::Three(mesh, data)) => {
             assert_valid(&mesh);
+            assert_written_back(&mesh, &data);
             if let Ok(mut surface) = Surface::from_mesh_boundary(&mesh) {
                 surface.split_faces_at_feature_edges(30.0);
                 let _ = surface.validate();
@@ -96,6 +102,29 @@ pub fn polygon_domain(data: &[u8]) {
         assert!(mesh.num_elements() <= ELEMENT_CAP, "{} triangles over the cap", mesh.num_elements());
         let (area, covered) = (domain.area(), mesh.total_volume());
         assert!((covered - area).abs() <= 1e-6 * area.abs().max(1e-300), "mesh area {covered} for domain {area}");
+    }
+}
+
+/// Every writer, in both element orders, on a mesh a reader accepted, with the fields and facet
+/// tags it read: a refusal names the file, and a written file reads back as the same mesh (the
+/// corners of a second-order one, each element counted as linearised).
+fn assert_written_back<const D: usize>(mesh: &Mesh<D>, data: &MeshData) {
+    let dir = scratch_dir();
+    for extension in MESH_EXTENSIONS {
+        for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+            let path = dir.join(format!("written.{extension}"));
+            let options = WriteOptions { order, ..WriteOptions::default() };
+            if let Err(e) = write_mesh_as(mesh, &path, data, options) {
+                assert_names(&e.to_string(), &path.display().to_string());
+                continue;
+            }
+            let (back, back_data) =
+                read_mesh_with_data::<D>(&path).unwrap_or_else(|e| panic!("{extension} {order:?}: {e}"));
+            assert!(&back == mesh, "{extension} {order:?}: read back as another mesh");
+            if order == ElementOrder::Quadratic {
+                assert_eq!(back_data.linearised.values().sum::<usize>(), mesh.num_elements(), "{extension}");
+            }
+        }
     }
 }
 

@@ -15,8 +15,8 @@ use std::path::Path;
 
 use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
-use super::{Lines, MeshData, tagged_facets, write_error};
-use crate::{FacetAdjacency, MeshError};
+use super::{Lines, MeshData, tagged_facets, write_error, writer_adjacency};
+use crate::MeshError;
 
 /// The kind of an Abaqus element type: the family prefix gives the dimension, the digits after it
 /// the node count.
@@ -157,7 +157,7 @@ pub(super) fn write<const D: usize>(
     path: &Path,
 ) -> Result<(), MeshError> {
     let mesh = nodes.mesh();
-    let adjacency = FacetAdjacency::new(mesh)?;
+    let adjacency = writer_adjacency(mesh, path)?;
     let side_of: HashMap<Vec<u32>, (usize, usize)> = adjacency
         .boundary_facets()
         .map(|(e, local)| {
@@ -168,7 +168,7 @@ pub(super) fn write<const D: usize>(
         })
         .collect();
     let mut groups: BTreeMap<i32, Vec<(usize, usize)>> = BTreeMap::new();
-    for (facet, tag) in tagged_facets(mesh, data, path)? {
+    for (facet, tag) in tagged_facets(mesh, &adjacency, data, path)? {
         let mut key = facet;
         key.sort_unstable();
         if let Some(&side) = side_of.get(&key) {

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use super::cursor::Cursor;
 use super::raw::{Kind, RawMesh};
-use super::{MeshData, tagged_facets, write_error};
+use super::{MeshData, tagged_facets, write_error, writer_adjacency};
 use crate::{Mesh, MeshError};
 
 /// Element sections: kind and nodes per entry.
@@ -107,7 +107,7 @@ pub(super) fn write<const D: usize>(
     w: &mut impl Write,
     path: &Path,
 ) -> Result<(), MeshError> {
-    let facets = tagged_facets(mesh, data, path)?;
+    let facets = tagged_facets(mesh, &writer_adjacency(mesh, path)?, data, path)?;
     write_body(mesh, &facets, w).map_err(write_error(path))
 }
 

@@ -373,10 +373,19 @@ pub fn write_mesh_as<const D: usize>(
     }
 }
 
+/// The facet adjacency of a mesh a writer groups the boundary of; a mesh without one (elements
+/// that overlap) is an error naming the file.
+fn writer_adjacency<const D: usize>(mesh: &Mesh<D>, path: &Path) -> Result<crate::FacetAdjacency, MeshError> {
+    crate::FacetAdjacency::new(mesh)
+        .map_err(|source| MeshError::InvalidMesh { path: path.to_owned(), source: Box::new(source) })
+}
+
 /// The facets a writer stores with their tags: every tagged facet, and the untagged boundary
-/// facets with `untagged` (one past the largest tag, or 1 when nothing is tagged).
+/// facets (of `adjacency`, the mesh's) with `untagged` (one past the largest tag, or 1 when
+/// nothing is tagged).
 fn tagged_facets<const D: usize>(
     mesh: &Mesh<D>,
+    adjacency: &crate::FacetAdjacency,
     data: &MeshData,
     path: &Path,
 ) -> Result<Vec<(Vec<u32>, i32)>, MeshError> {
@@ -389,7 +398,7 @@ fn tagged_facets<const D: usize>(
     let untagged = data.facet_tags.values().max().map_or(1, |&t| t.saturating_add(1));
     let mut facets: Vec<(Vec<u32>, i32)> = Vec::new();
     let mut seen = std::collections::BTreeSet::new();
-    for facet in crate::FacetAdjacency::new(mesh)?.oriented_boundary_facets(mesh) {
+    for facet in adjacency.oriented_boundary_facets(mesh) {
         let facet = facet.to_vec();
         let mut key = facet.clone();
         key.sort_unstable();

@@ -20,7 +20,7 @@ use std::path::Path;
 use super::cursor::{Cursor, Scalar};
 use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
-use super::{MeshData, tagged_facets, write_error};
+use super::{MeshData, tagged_facets, write_error, writer_adjacency};
 use crate::MeshError;
 
 /// The kind and node count of a gmsh element type.
@@ -491,7 +491,7 @@ pub(super) fn write<const D: usize>(
             });
         }
     }
-    let facets = tagged_facets(nodes.mesh(), data, path)?;
+    let facets = tagged_facets(nodes.mesh(), &writer_adjacency(nodes.mesh(), path)?, data, path)?;
     if let Some((_, tag)) = facets.iter().find(|(_, t)| *t <= 0) {
         let message = format!("facet tag {tag}: gmsh physical groups need positive tags");
         return Err(MeshError::Format { path: path.to_owned(), message });
