@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use amber_experiments::{ModelCard, Task, resolve_model};
 use amber_mesh::{
-    AnyMesh, ElementOrder, Mesh, Mesh2, Mesh3, MeshData, WriteOptions, read_any_mesh, read_mesh, read_mesh_with_data,
-    write_mesh, write_mesh_as,
+    AnyMesh, ElementOrder, Mesh, Mesh2, Mesh3, MeshData, WriteOptions, check_output, read_any_mesh, read_mesh,
+    read_mesh_with_data, write_mesh, write_mesh_as,
 };
 use amber_meshgen::mesh3d::{Mesh3dParams, SurfaceDistance, generate_3d};
 use amber_meshgen::{
@@ -93,6 +93,10 @@ pub struct MeshArgs {
 }
 
 pub fn run(args: MeshArgs) -> anyhow::Result<()> {
+    // A format that cannot take the output fails now, not after the meshing.
+    if args.output.extension().and_then(|e| e.to_str()) != Some("png") {
+        check_output(&args.output, output_options(&args))?;
+    }
     match &args.model {
         Some(model) => with_model(&args, model),
         None => with_size(&args, args.size.as_deref().expect("clap requires --size without --model")),
@@ -372,11 +376,13 @@ where
             let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
             mesh.picture(&sizes, &options, output)
         }
-        _ => {
-            let options = WriteOptions { order: args.order, ..WriteOptions::default() };
-            Ok(write_mesh_as(mesh, output, &data.with_cell("size", sizes), options)?)
-        }
+        _ => Ok(write_mesh_as(mesh, output, &data.with_cell("size", sizes), output_options(args))?),
     }
+}
+
+/// How the output mesh is written: in `--order`, each format's default encoding.
+fn output_options(args: &MeshArgs) -> WriteOptions {
+    WriteOptions { order: args.order, ..WriteOptions::default() }
 }
 
 /// `--size`: a 2D geometry meshed from a given field, or a 3D one from a constant size.

@@ -19,8 +19,9 @@ mod mesh;
 pub use adjacency::FacetAdjacency;
 pub use error::MeshError;
 pub use io::{
-    AnyMesh, ElementOrder, Encoding, MESH_FORMATS, MeshData, StlFaceIds, TriangleSoup, WriteOptions, parse_any_mesh,
-    parse_surface, read_any_mesh, read_mesh, read_mesh_with_data, read_surface, write_mesh, write_mesh_as,
+    AnyMesh, ElementOrder, Encoding, MESH_FORMATS, MeshData, StlFaceIds, TriangleSoup, WriteOptions, check_output,
+    parse_any_mesh, parse_surface, read_any_mesh, read_mesh, read_mesh_with_data, read_surface, write_mesh,
+    write_mesh_as,
 };
 pub use locate::{Location, PointLocator};
 pub use mesh::{Mesh, Mesh2, Mesh3, bounding_box, centroid, signed_volume, size_from_volume, volume_from_size};

@@ -347,9 +347,30 @@ pub fn write_mesh_as<const D: usize>(
     options: WriteOptions,
 ) -> Result<(), MeshError> {
     let path = path.as_ref();
+    let (format, binary) = output_format(path, options)?;
+    data.check_lengths(path, mesh.num_elements(), mesh.num_vertices())?;
+    let nodes = Nodes::new(mesh, options.order);
+    match format {
+        Format::Vtu => write_atomic(path, |w| vtu::write(&nodes, data, binary, w).map_err(write_error(path))),
+        Format::Vtk => write_atomic(path, |w| vtk::write(&nodes, data, binary, w, path)),
+        Format::Msh => write_atomic(path, |w| msh::write(&nodes, data, binary, w, path)),
+        Format::Json => write_atomic(path, |w| json::write(mesh, data, w, path)),
+        Format::Nastran => write_atomic(path, |w| nastran::write(&nodes, w).map_err(write_error(path))),
+        Format::Abaqus => write_atomic(path, |w| abaqus::write(&nodes, data, w, path)),
+        Format::Medit => write_atomic(path, |w| medit::write(mesh, data, w, path)),
+    }
+}
+
+/// Checks before any work that [`write_mesh_as`] can write `path` with `options`: a mesh format
+/// by extension, with the encoding and element order asked for. The error names the file.
+pub fn check_output(path: &Path, options: WriteOptions) -> Result<(), MeshError> {
+    output_format(path, options).map(|_| ())
+}
+
+/// The format of `path` and whether it is written in binary, or why it cannot be written so.
+fn output_format(path: &Path, options: WriteOptions) -> Result<(Format, bool), MeshError> {
     let format = format_of(path)
         .ok_or_else(|| MeshError::UnsupportedFormat { path: path.to_owned(), expected: MESH_FORMATS })?;
-    data.check_lengths(path, mesh.num_elements(), mesh.num_vertices())?;
     let binary = match (format, options.encoding) {
         (Format::Vtu, None) | (_, Some(Encoding::Binary)) => true,
         (_, None | Some(Encoding::Ascii)) => false,
@@ -361,16 +382,7 @@ pub fn write_mesh_as<const D: usize>(
     if options.order == ElementOrder::Quadratic && matches!(format, Format::Json | Format::Medit) {
         return refuse("second-order elements are written to .msh, .vtu, .vtk, .nas and .inp only");
     }
-    let nodes = Nodes::new(mesh, options.order);
-    match format {
-        Format::Vtu => write_atomic(path, |w| vtu::write(&nodes, data, binary, w).map_err(write_error(path))),
-        Format::Vtk => write_atomic(path, |w| vtk::write(&nodes, data, binary, w, path)),
-        Format::Msh => write_atomic(path, |w| msh::write(&nodes, data, binary, w, path)),
-        Format::Json => write_atomic(path, |w| json::write(mesh, data, w, path)),
-        Format::Nastran => write_atomic(path, |w| nastran::write(&nodes, w).map_err(write_error(path))),
-        Format::Abaqus => write_atomic(path, |w| abaqus::write(&nodes, data, w, path)),
-        Format::Medit => write_atomic(path, |w| medit::write(mesh, data, w, path)),
-    }
+    Ok((format, binary))
 }
 
 /// The facet adjacency of a mesh a writer groups the boundary of; a mesh without one (elements
