@@ -36,7 +36,7 @@ use crate::{Mesh, Mesh2, Mesh3, MeshError};
 /// or per vertex (`point`), tags on boundary facets, and what a reader left out.
 ///
 /// `.vtu`, `.vtk`, `.msh` and `.json` store the fields; `.nas`, `.inp` and `.mesh` none. `.msh`
-/// and `.mesh` store the facet tags.
+/// and `.mesh` store the facet tags; `.inp` writes them as node sets and element-side surfaces.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {
     /// Per-element fields, by name.
