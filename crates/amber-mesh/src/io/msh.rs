@@ -54,19 +54,11 @@ fn element_type(t: i64) -> Option<(Kind, usize)> {
     })
 }
 
-/// The gmsh type of the linear simplex of dimension `dim` (1 to 3).
-fn simplex_type(dim: usize) -> i32 {
-    [15, 1, 2, 4][dim]
+/// The gmsh type of the simplex of dimension `dim` (1 to 3), linear or quadratic: point, (3-node)
+/// line, (6-node) triangle, (10-node) tetrahedron.
+fn simplex_type(dim: usize, quadratic: bool) -> i32 {
+    if quadratic { [15, 8, 9, 11][dim] } else { [15, 1, 2, 4][dim] }
 }
-
-/// The gmsh element types of the second-order simplices by dimension: point, 3-node line,
-/// 6-node triangle, 10-node tetrahedron.
-const QUADRATIC_SIMPLEX_TYPES: [i32; 4] = [15, 8, 9, 11];
-
-/// gmsh's node order of a 10-node tetrahedron, as positions in VTK's.
-const GMSH_TETRA10: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 9, 8];
-
-const IDENTITY: [usize; 10] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9];
 
 /// The numbers of a section body: words in an ASCII file, `int` / `size_t` / `double` in a
 /// binary one.
@@ -596,26 +588,36 @@ fn write_body<const D: usize, W: Write>(
     }
     out.end_record()?;
     let quadratic = nodes.is_quadratic();
-    let block = |out: &mut Out<W>, dim: usize, entity: i32, elements: &[Vec<u32>], first_tag| {
+    let block = |out: &mut Out<W>,
+                 dim: usize,
+                 entity: i32,
+                 elements: &mut dyn ExactSizeIterator<Item = Vec<u32>>,
+                 first_tag| {
+        let count = elements.len();
         out.int(dim as i32)?;
         out.int(entity)?;
-        out.int(if quadratic { QUADRATIC_SIMPLEX_TYPES[dim] } else { simplex_type(dim) })?;
-        out.size(elements.len())?;
+        out.int(simplex_type(dim, quadratic))?;
+        out.size(count)?;
         out.end_record()?;
-        for (k, element) in elements.iter().enumerate() {
+        for (k, element) in elements.enumerate() {
             out.size(first_tag + k)?;
-            // gmsh numbers a 10-node tetrahedron's last two edges 2-3, 1-3, VTK's 1-3, 2-3.
-            let order: &[usize] = if quadratic && dim == 3 { &GMSH_TETRA10 } else { &IDENTITY[..element.len()] };
-            for &i in order {
-                out.size(element[i] as usize + 1)?;
+            for v in element {
+                out.size(v as usize + 1)?;
             }
             out.end_record()?;
         }
-        Ok::<usize, std::io::Error>(first_tag + elements.len())
+        Ok::<usize, std::io::Error>(first_tag + count)
     };
-    let mut next_tag = block(out, D, 1, &nodes.elements().collect::<Vec<_>>(), 1)?;
+    // gmsh numbers a 10-node tetrahedron's last two edges 2-3, 1-3; VTK's order (the nodes') 1-3, 2-3.
+    let mut domain = nodes.elements().map(|mut element| {
+        if element.len() == 10 {
+            element.swap(8, 9);
+        }
+        element
+    });
+    let mut next_tag = block(out, D, 1, &mut domain, 1)?;
     for (k, members) in groups.values().enumerate() {
-        next_tag = block(out, D - 1, k as i32 + 1, members, next_tag)?;
+        next_tag = block(out, D - 1, k as i32 + 1, &mut members.iter().cloned(), next_tag)?;
     }
     if out.binary {
         out.line("")?;

@@ -78,7 +78,7 @@ impl<'m, const D: usize> Nodes<'m, D> {
 
     /// The nodes of each element: its corners, then (second order) its edge nodes in [`EDGES`]'
     /// order.
-    pub(super) fn elements(&self) -> impl Iterator<Item = Vec<u32>> + '_ {
+    pub(super) fn elements(&self) -> impl ExactSizeIterator<Item = Vec<u32>> + '_ {
         self.mesh.elements().map(|cell| self.with_edge_nodes(cell, &EDGES[..Self::edges_per_element()]))
     }
 
