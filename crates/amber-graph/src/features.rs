@@ -72,6 +72,33 @@ impl FeatureSet {
     pub fn edge_dim(&self, dim: usize) -> usize {
         self.edge.iter().map(|f| f.width(dim)).sum()
     }
+
+    /// Whether an edge feature is a vector, which turns with the mesh (the other features do not).
+    pub fn has_edge_vectors(&self) -> bool {
+        self.edge.contains(&EdgeFeature::MidpointDifference)
+    }
+
+    /// Turns every edge vector of `rows` (edge feature rows of a `D`-dimensional mesh) by the
+    /// orthogonal matrix `q`: the features of the same mesh rotated or reflected by `q`.
+    pub fn transform_edge_vectors<const D: usize>(&self, rows: &mut [f32], q: &[[f64; D]; D]) {
+        let dim = self.edge_dim(D);
+        let mut column = 0;
+        let mut starts = Vec::new();
+        for feature in &self.edge {
+            if *feature == EdgeFeature::MidpointDifference {
+                starts.push(column);
+            }
+            column += feature.width(D);
+        }
+        for row in rows.chunks_exact_mut(dim) {
+            for &start in &starts {
+                let v: [f64; D] = std::array::from_fn(|k| f64::from(row[start + k]));
+                for (i, out) in row[start..start + D].iter_mut().enumerate() {
+                    *out = (0..D).map(|k| q[i][k] * v[k]).sum::<f64>() as f32;
+                }
+            }
+        }
+    }
 }
 
 /// A caller-provided per-element feature column, matched to [`NodeFeature::Column`] by name.
@@ -90,6 +117,22 @@ mod tests {
     fn widths_follow_the_spec() {
         assert_eq!((FeatureSet::poisson().node_dim(), FeatureSet::poisson().edge_dim(2)), (4, 1));
         assert_eq!((FeatureSet::console().node_dim(), FeatureSet::console().edge_dim(3)), (1, 3));
+    }
+
+    #[test]
+    fn only_edge_vectors_turn() {
+        let features = FeatureSet {
+            node: vec![NodeFeature::Volume],
+            edge: vec![EdgeFeature::MidpointDistance, EdgeFeature::MidpointDifference],
+        };
+        assert!(features.has_edge_vectors() && !FeatureSet::poisson().has_edge_vectors());
+        // A quarter turn about z, then a reflection of x.
+        let quarter = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        let mut rows = vec![3.0, 1.0, 2.0, 2.0, 5.0, 0.0, 0.0, 5.0];
+        features.transform_edge_vectors(&mut rows, &quarter);
+        assert_eq!(rows, vec![3.0, -2.0, 1.0, 2.0, 5.0, 0.0, 0.0, 5.0]);
+        features.transform_edge_vectors(&mut rows, &[[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+        assert_eq!(rows, vec![3.0, 2.0, 1.0, 2.0, 5.0, 0.0, 0.0, 5.0]);
     }
 
     #[test]

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::{GraphBatch, GraphError, MeshGraph};
+use crate::{FeatureSet, GraphBatch, GraphError, MeshGraph};
 
 /// Normalised features are clipped to ±`CLIP`.
 pub const CLIP: f64 = 20.0;
@@ -148,6 +148,27 @@ impl FeatureNormaliser {
         self.edge.update(graph.edge_features())
     }
 
+    /// Merges `graph` as [`Self::update`] does, its edge vectors once along each cyclic
+    /// permutation of the axes of its `D`-dimensional mesh: every component of a vector then
+    /// has the same mean and variance, as in a training that turns each graph at random
+    /// ([`FeatureSet::transform_edge_vectors`]), so the normaliser favours no axis.
+    pub fn update_all_axes_alike<const D: usize>(
+        &mut self,
+        graph: &MeshGraph,
+        features: &FeatureSet,
+    ) -> Result<(), GraphError> {
+        self.check_dims(graph.node_dim(), graph.edge_dim())?;
+        self.node.update(graph.node_features())?;
+        for shift in 0..D {
+            let permutation: [[f64; D]; D] =
+                std::array::from_fn(|i| std::array::from_fn(|k| f64::from((i + shift) % D == k)));
+            let mut rows = graph.edge_features().to_vec();
+            features.transform_edge_vectors(&mut rows, &permutation);
+            self.edge.update(&rows)?;
+        }
+        Ok(())
+    }
+
     /// Normalises the features of `batch` in place.
     pub fn normalise(&self, batch: &mut GraphBatch) -> Result<(), GraphError> {
         self.check_dims(batch.node_dim, batch.edge_dim)?;
@@ -246,6 +267,32 @@ mod tests {
         let mean = batch.node_features.iter().sum::<f32>() / batch.num_nodes as f32;
         assert!(mean.abs() < 1e-5);
         assert!(matches!(FeatureNormaliser::new(2, 2).update(&graph), Err(GraphError::DimensionMismatch { .. })));
+    }
+
+    #[test]
+    fn all_axes_alike_pools_the_moments_of_a_vector_s_components() {
+        use crate::{EdgeFeature, FeatureSet, NodeFeature};
+        // A strip of triangles along x: its midpoint differences are longer along x than y.
+        let strip = amber_mesh::Mesh2::new(
+            (0..=10).flat_map(|i| [[f64::from(i), 0.0], [f64::from(i), 1.0]]).collect(),
+            (0..10u32).flat_map(|i| [2 * i, 2 * i + 2, 2 * i + 1, 2 * i + 1, 2 * i + 2, 2 * i + 3]).collect(),
+        )
+        .unwrap();
+        let features = FeatureSet {
+            node: vec![NodeFeature::Volume],
+            edge: vec![EdgeFeature::MidpointDistance, EdgeFeature::MidpointDifference],
+        };
+        let graph = MeshGraph::new(&strip, &features, &[]).unwrap();
+        let mut plain = FeatureNormaliser::new(1, 3);
+        plain.update(&graph).unwrap();
+        let mut alike = FeatureNormaliser::new(1, 3);
+        alike.update_all_axes_alike::<2>(&graph, &features).unwrap();
+        let (p, a) = (plain.edge.variance(), alike.edge.variance());
+        assert!(p[1] > 2.0 * p[2], "{p:?}");
+        // The distance keeps its moments; x and y each get the pooled ones.
+        assert!((a[0] - p[0]).abs() < 1e-6 * p[0]);
+        assert!((a[1] - a[2]).abs() < 1e-9 && (a[1] - 0.5 * (p[1] + p[2])).abs() < 1e-3 * a[1], "{a:?} {p:?}");
+        assert_eq!(alike.node, plain.node);
     }
 
     #[test]

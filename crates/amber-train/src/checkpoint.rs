@@ -129,6 +129,9 @@ pub(crate) struct TrainingState {
     pub optimiser_steps: u64,
     pub dropout_rng: RngState,
     pub buffer_rng: RngState,
+    /// The orientation stream, in a run that turns its batches (`random_orientation`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation_rng: Option<RngState>,
     pub problems: Vec<ProblemFingerprint>,
     pub next_entry_id: u64,
     pub protected: Vec<EntryRecord>,
@@ -358,6 +361,7 @@ mod tests {
             optimiser_steps: 0,
             dropout_rng: rng.clone(),
             buffer_rng: rng.clone(),
+            orientation_rng: None,
             problems: Vec::new(),
             next_entry_id,
             protected,

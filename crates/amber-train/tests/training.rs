@@ -123,7 +123,21 @@ impl TrainingObserver for KillAfter {
 
 #[test]
 fn a_resumed_run_continues_exactly_where_the_killed_one_stopped() {
-    let config = TrainingConfig { checkpoint_interval: 7, ..tiny_config(20) };
+    resumes_exactly(TrainingConfig { checkpoint_interval: 7, ..tiny_config(20) });
+}
+
+/// Random orientations come from their own seeded stream, which the checkpoint keeps.
+#[test]
+fn a_resumed_run_in_random_orientations_continues_exactly() {
+    resumes_exactly(TrainingConfig {
+        checkpoint_interval: 7,
+        edge_features: Some(vec![EdgeFeature::MidpointDistance, EdgeFeature::MidpointDifference]),
+        random_orientation: true,
+        ..tiny_config(20)
+    });
+}
+
+fn resumes_exactly(config: TrainingConfig) {
     let dir = tempfile::tempdir().unwrap();
     let (whole, killed) = (dir.path().join("whole"), dir.path().join("killed"));
     single_thread(|| {
@@ -281,8 +295,33 @@ fn a_configured_edge_feature_set_replaces_the_tasks() {
     assert!(model.predict(&[&state]).unwrap()[0].iter().all(|h| h.is_finite() && *h > 0.0));
 
     let none = TrainingConfig { edge_features: Some(Vec::new()), ..tiny_config(2) };
-    let Err(error) = Training::new(none, problems) else { panic!("trained without edge features") };
+    let Err(error) = Training::new(none, problems.clone()) else { panic!("trained without edge features") };
     assert!(error.to_string().contains("edge_features"), "{error}");
+}
+
+/// A run in random orientations normalises every axis alike, trains on turned batches (other
+/// losses than the same run's without), and refuses edge features with no vector to turn.
+#[test]
+fn random_orientation_turns_the_batches_and_pools_the_axes() {
+    let edge_features = vec![EdgeFeature::MidpointDistance, EdgeFeature::MidpointDifference];
+    let config = TrainingConfig { edge_features: Some(edge_features), ..tiny_config(4) };
+    let turned = TrainingConfig { random_orientation: true, ..config.clone() };
+    let losses = |config: TrainingConfig| {
+        let mut training = Training::new(config, problems(&[11, 12])).unwrap();
+        let losses: Vec<f64> = (0..4).map(|_| training.train_step().unwrap().loss).collect();
+        (losses, training.predictor().normaliser.clone().unwrap())
+    };
+    let ((plain, plain_moments), (turned_losses, turned_moments)) = (losses(config), losses(turned.clone()));
+    assert_ne!(plain, turned_losses);
+    let [_, x, y] = plain_moments.edge.variance().try_into().unwrap();
+    assert_ne!(x, y);
+    let [_, x, y] = turned_moments.edge.variance().try_into().unwrap();
+    assert!((x - y).abs() < 1e-12 * x, "{x} {y}");
+    assert_eq!(losses(turned).0, turned_losses, "the same seed turns the same way");
+
+    let poisson = TrainingConfig { random_orientation: true, ..tiny_config(2) };
+    let Err(error) = Training::new(poisson, problems(&[11, 12])) else { panic!("turned a distance") };
+    assert!(error.to_string().contains("midpoint_difference"), "{error}");
 }
 
 #[cfg(not(feature = "cuda"))]

@@ -45,6 +45,12 @@ pub struct TrainingConfig {
     /// network that cannot tell a part's orientation. None: the task's.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub edge_features: Option<Vec<EdgeFeature>>,
+    /// Turn every graph of every training batch by a random rotation or reflection (its edge
+    /// vectors, `midpoint_difference`), so that the network cannot learn the training parts'
+    /// orientations and sees each part from many sides; the input normaliser then treats every
+    /// axis alike. Needs an edge vector feature; off in the paper.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub random_orientation: bool,
     /// The network.
     pub network: NetworkConfig,
     /// Gradient steps.
@@ -116,6 +122,7 @@ impl TrainingConfig {
             normalise_inputs: true,
             inputs: Vec::new(),
             edge_features: None,
+            random_orientation: false,
             network: NetworkConfig::default(),
             steps: 128_000,
             learning_rate: PAPER_LEARNING_RATE,

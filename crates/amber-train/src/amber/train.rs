@@ -6,14 +6,16 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use amber_graph::{FeatureNormaliser, GraphBatch};
+use amber_graph::{FeatureNormaliser, FeatureSet, GraphBatch};
 use amber_mesh::Mesh;
 use amber_mpn::{Mpn, MpnConfig, MpnTrainer};
 use amber_stdx::{read_json, write_json_atomic};
 use amber_tasks::{
     LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step, labels, with_inputs,
 };
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -81,6 +83,8 @@ pub struct Training<const D: usize, P: Problem<D>> {
     step: u64,
     dropout_rng: ChaCha8Rng,
     buffer_rng: ChaCha8Rng,
+    /// Draws the batch graphs' orientations (`random_orientation`).
+    orientation_rng: ChaCha8Rng,
     additions: AdditionCounts,
 }
 
@@ -104,6 +108,11 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         if let Some(edge) = &config.edge_features {
             features.edge.clone_from(edge);
         }
+        if config.random_orientation && !features.has_edge_vectors() {
+            return Err(TrainError::InvalidConfig(
+                "random_orientation turns the edge vectors, but the edge features have none (add \"midpoint_difference\" to edge_features)".into(),
+            ));
+        }
         let limits = MeshLimits::from_experts(
             problems.iter().map(|p| p.expert_mesh()),
             config.budget_factor,
@@ -123,6 +132,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             buffer: ReplayBuffer::new(config.buffer_capacity),
             dropout_rng: seeded_stream(config.seed, 1),
             buffer_rng: seeded_stream(config.seed, 2),
+            orientation_rng: seeded_stream(config.seed, ORIENTATION_STREAM),
             config,
             trainer,
             predictor: Predictor { features, normaliser, target, limits },
@@ -179,6 +189,10 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         Ok(Self {
             dropout_rng: state.dropout_rng.restore(dir)?,
             buffer_rng: state.buffer_rng.restore(dir)?,
+            orientation_rng: match &state.orientation_rng {
+                Some(rng) => rng.restore(dir)?,
+                None => seeded_stream(config.seed, ORIENTATION_STREAM),
+            },
             config,
             problems,
             trainer,
@@ -240,7 +254,12 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
     /// Merges a graph entering the buffer into the running normalisers.
     fn observe(&mut self, sample: &Sample<D>) -> Result<()> {
         if let Some(normaliser) = &mut self.predictor.normaliser {
-            normaliser.update(&sample.state.graph)?;
+            let graph = &sample.state.graph;
+            if self.config.random_orientation {
+                normaliser.update_all_axes_alike::<D>(graph, &self.predictor.features)?;
+            } else {
+                normaliser.update(graph)?;
+            }
         }
         self.predictor.target.update(&sample.targets);
         Ok(())
@@ -253,6 +272,9 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let chosen = self.buffer.next_batch(self.config.batch_nodes);
         let entries: Vec<_> = chosen.iter().map(|&i| self.buffer.get(i)).collect();
         let mut batch = GraphBatch::from_graphs(entries.iter().map(|e| &e.sample.state.graph))?;
+        if self.config.random_orientation {
+            turn_at_random::<D>(&mut batch, &self.predictor.features, &mut self.orientation_rng);
+        }
         if let Some(normaliser) = &self.predictor.normaliser {
             normaliser.normalise(&mut batch)?;
         }
@@ -376,6 +398,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             optimiser_steps: self.trainer.optimiser_steps(),
             dropout_rng: RngState::of(&self.dropout_rng),
             buffer_rng: RngState::of(&self.buffer_rng),
+            orientation_rng: self.config.random_orientation.then(|| RngState::of(&self.orientation_rng)),
             problems: fingerprints(&self.problems),
             next_entry_id: self.buffer.next_id(),
             protected: records(&mut self.buffer.protected().iter()),
@@ -388,6 +411,43 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             Ok(write_json_atomic(&dir.join(STATE_FILE), &state)?)
         })
     }
+}
+
+/// The random stream of the batch graphs' orientations (after edge dropout's 1 and the buffer's 2).
+const ORIENTATION_STREAM: u64 = 3;
+
+/// Turns each graph of `batch` by its own random orthogonal matrix (uniform over rotations and
+/// reflections).
+fn turn_at_random<const D: usize>(batch: &mut GraphBatch, features: &FeatureSet, rng: &mut ChaCha8Rng) {
+    let width = batch.edge_dim;
+    for graph in 0..batch.num_graphs() {
+        let q = random_orthogonal::<D>(rng);
+        let [first, last] = [graph, graph + 1].map(|g| batch.dst_offsets[batch.node_offsets[g] as usize] as usize);
+        features.transform_edge_vectors(&mut batch.edge_features[first * width..last * width], &q);
+    }
+}
+
+/// A random orthogonal matrix, uniform (Haar) over the rotations and reflections of `D`
+/// dimensions: Gram–Schmidt on `D` standard normal vectors.
+fn random_orthogonal<const D: usize>(rng: &mut ChaCha8Rng) -> [[f64; D]; D] {
+    let mut q = [[0.0; D]; D];
+    let mut i = 0;
+    while i < D {
+        let mut v: [f64; D] = std::array::from_fn(|_| rng.sample(StandardNormal));
+        // Twice, so that the rows are orthogonal to rounding even when the draw nearly lies in
+        // their span ("twice is enough").
+        for row in q[..i].iter().chain(&q[..i]) {
+            let along: f64 = row.iter().zip(&v).map(|(a, b)| a * b).sum();
+            v.iter_mut().zip(row).for_each(|(x, a)| *x -= along * a);
+        }
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        // A draw (almost) in the span of the rows so far is drawn again.
+        if norm > 1e-6 {
+            q[i] = v.map(|x| x / norm);
+            i += 1;
+        }
+    }
+    q
 }
 
 /// One line of the training log.
@@ -453,6 +513,30 @@ fn loss_by_depth(squared_errors: &[f32], graphs: impl Iterator<Item = (usize, us
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn random_orthogonal_matrices_are_orthogonal_and_unbiased() {
+        let mut rng = seeded_stream(7, ORIENTATION_STREAM);
+        let (mut mean, mut reflections) = ([[0.0; 3]; 3], 0);
+        let draws = 4000;
+        for _ in 0..draws {
+            let q = random_orthogonal::<3>(&mut rng);
+            for i in 0..3 {
+                for j in 0..3 {
+                    let dot: f64 = (0..3).map(|k| q[i][k] * q[j][k]).sum();
+                    assert!((dot - f64::from(i == j)).abs() < 1e-12);
+                    mean[i][j] += q[i][j] / f64::from(draws);
+                }
+            }
+            let det = q[0][0] * (q[1][1] * q[2][2] - q[1][2] * q[2][1])
+                - q[0][1] * (q[1][0] * q[2][2] - q[1][2] * q[2][0])
+                + q[0][2] * (q[1][0] * q[2][1] - q[1][1] * q[2][0]);
+            reflections += usize::from(det < 0.0);
+        }
+        // Every entry of a Haar matrix has mean 0 (standard deviation 1/√3 here); half are reflections.
+        assert!(mean.iter().flatten().all(|m| m.abs() < 0.05), "{mean:?}");
+        assert!((1800..2200).contains(&reflections), "{reflections}");
+    }
 
     #[test]
     fn the_loss_by_depth_averages_over_the_nodes_of_each_depth() {
