@@ -22,7 +22,7 @@ use amber_tasks::part::{
     read_solid_surface,
 };
 use amber_tasks::poisson::{PoissonPart, read_part};
-use amber_tasks::{Domain, SizeBounds, WithExpert};
+use amber_tasks::{Domain, RefineBox, SizeBounds, WithExpert};
 use amber_train::{ElementTarget, FinalStep, GeneratedStep, MeshMetrics, Reference, TrainError, TrainedModel};
 use anyhow::{Context, bail};
 use clap::Args;
@@ -62,6 +62,13 @@ pub struct MeshArgs {
     /// Hold the final step's sizing field at or below this size.
     #[arg(long, requires = "model")]
     max_size: Option<f64>,
+    /// A box where the final mesh's elements are to be no larger than SIZE (a bolt hole, a weld,
+    /// where the stresses matter): `X0,Y0,X1,Y1,SIZE` in 2D, `X0,Y0,Z0,X1,Y1,Z1,SIZE` in 3D, the
+    /// box's lower and upper corners. The last step's field is held at SIZE on every element of
+    /// the mesh before it that meets the box (so the refinement may reach one such element
+    /// beyond it); --elements counts the box's elements in. May be given more than once.
+    #[arg(long, requires = "model", value_parser = parse_refine_box, value_name = "CORNERS,SIZE", allow_hyphen_values = true)]
+    refine_box: Vec<RefineBox>,
     /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,
     /// and its domain when no geometry is given; its expert mesh, when present, is the default
     /// --expert), or a part's inputs (`<stem>.inputs.json`: named numbers and points) for a model
@@ -222,8 +229,14 @@ where
 {
     let start = Instant::now();
     let target = args.elements.map(|elements| ElementTarget { elements, max_elements: args.max_elements });
-    let bounds =
+    let mut bounds =
         SizeBounds::new(args.min_size, args.max_size).map_err(|e| anyhow::anyhow!("--min-size/--max-size: {e}"))?;
+    for refine in &args.refine_box {
+        if refine.lo.len() != D {
+            anyhow::bail!("--refine-box: a box of {} dimensions for a {D}D geometry", refine.lo.len());
+        }
+        bounds = bounds.with_box(refine.clone()).map_err(|e| anyhow::anyhow!("--refine-box: {e}"))?;
+    }
     let generated = model.generate(&domain, steps, FinalStep { target, bounds }).map_err(|e| match e {
         TrainError::MissingInputs(_) => anyhow::anyhow!("{e}: give the part's inputs with --problem FILE.inputs.json"),
         e => e.into(),
@@ -445,6 +458,18 @@ fn mesh_with<F: SizingField<2>>(
     let mesh = generate_2d(domain, field, params).context("mesh generation failed")?;
     let report = QualityReport::measure(&mesh, field);
     Ok((mesh, report))
+}
+
+fn parse_refine_box(text: &str) -> Result<RefineBox, String> {
+    match text.split(',').map(str::trim).map(str::parse::<f64>).collect::<Result<Vec<_>, _>>() {
+        Ok(v) if v.len() == 5 || v.len() == 7 => {
+            let dim = (v.len() - 1) / 2;
+            Ok(RefineBox { lo: v[..dim].to_vec(), hi: v[dim..2 * dim].to_vec(), max_size: v[2 * dim] })
+        }
+        _ => Err(format!(
+            "expected X0,Y0,X1,Y1,SIZE (2D) or X0,Y0,Z0,X1,Y1,Z1,SIZE (3D), comma-separated numbers, got `{text}`"
+        )),
+    }
 }
 
 fn parse_point(text: &str) -> Result<[f64; 2], String> {

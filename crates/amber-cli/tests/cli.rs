@@ -211,6 +211,35 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
         assert!(low > 0.04 && high < 0.06, "5 % and 95 % of sizes {low}, {high} for a field of 0.05");
     }
 
+    // A refinement box: its elements take the box's size, where the same mesh without it has
+    // coarser ones, and the far corner is left as it was. A box of the wrong dimension, or not a
+    // box, is an error naming the flag.
+    let medians = |knobs: &[&str]| {
+        let output = mesh_square(knobs);
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        let mesh = amber_mesh::read_mesh::<2>(&final_mesh).unwrap();
+        let median_where = |inside: &dyn Fn([f64; 2]) -> bool| {
+            let mut h: Vec<f64> =
+                mesh.midpoints().iter().zip(mesh.sizes()).filter(|(x, _)| inside(**x)).map(|(_, h)| h).collect();
+            h.sort_by(f64::total_cmp);
+            h[h.len() / 2]
+        };
+        [median_where(&|x| x[0] < 0.25 && x[1] < 0.25), median_where(&|x| x[0] > 0.7 && x[1] > 0.7)]
+    };
+    let range = ["--min-size", "0.02", "--max-size", "0.05"];
+    let [box_before, far_before] = medians(&range);
+    let [in_box, far] = medians(&[&range[..], &["--refine-box", "-1,-1,0.3,0.3,0.02"]].concat());
+    assert!(in_box < 0.025 && in_box < 0.8 * box_before, "box median {in_box}, without the box {box_before}");
+    assert!((far / far_before - 1.0).abs() < 0.15, "far median {far}, without the box {far_before}");
+    for refine in ["0,0,0,1,1,1,0.02", "0,0,1,1", "0,0,0.3,0.3,0.01"] {
+        let output = mesh_square(&["--min-size", "0.02", "--refine-box", refine]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && stderr.contains("--refine-box") && !stderr.contains("panicked"),
+            "{stderr}"
+        );
+    }
+
     // A missing model, or a Poisson model without its load, is an error with a message.
     for args in [vec!["--model", "/nonexistent", "--problem"], vec!["square", "--model"]] {
         let mut command = amber();

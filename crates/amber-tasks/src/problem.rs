@@ -299,20 +299,31 @@ pub const ELEMENT_COUNT_TOLERANCE: f64 = 0.05;
 /// Meshings [`mesh_to_element_count`] tries before it returns its closest mesh.
 const ELEMENT_COUNT_ATTEMPTS: usize = 5;
 
-/// The range a user allows a final mesh's sizing field (`amber mesh --min-size/--max-size`): an
-/// explicit solver's time step is set by its smallest element, a contact or a result plot wants no
-/// element above a size. Sizes outside are clamped after every other scaling, so the model still
-/// decides where elements go inside the range.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// What a user allows a final mesh's sizing field (`amber mesh --min-size/--max-size/--refine-box`):
+/// a range (an explicit solver's time step is set by its smallest element; a contact or a result
+/// plot wants no element above a size) and boxes where elements are to be no larger than a size
+/// (a bolt hole, a weld, where the stresses matter). They act after every other scaling, so the
+/// model still decides where elements go within them.
+#[derive(Clone, Debug, PartialEq)]
 pub struct SizeBounds {
     min: f64,
     max: f64,
+    boxes: Vec<RefineBox>,
+}
+
+/// An axis-aligned box (corners `lo`, `hi` in the geometry's `lo.len()` dimensions) where the
+/// sizing field is held at or below `max_size`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefineBox {
+    pub lo: Vec<f64>,
+    pub hi: Vec<f64>,
+    pub max_size: f64,
 }
 
 impl Default for SizeBounds {
     /// No bounds.
     fn default() -> Self {
-        Self { min: 0.0, max: f64::INFINITY }
+        Self { min: 0.0, max: f64::INFINITY, boxes: Vec::new() }
     }
 }
 
@@ -325,16 +336,66 @@ impl SizeBounds {
                 return Err(format!("the {name} size must be a positive number, not {h}"));
             }
         }
-        let bounds = Self { min: min.unwrap_or(0.0), max: max.unwrap_or(f64::INFINITY) };
+        let bounds = Self { min: min.unwrap_or(0.0), max: max.unwrap_or(f64::INFINITY), boxes: Vec::new() };
         if bounds.min > bounds.max {
             return Err(format!("the minimum size {} is above the maximum size {}", bounds.min, bounds.max));
         }
         Ok(bounds)
     }
 
-    /// `h` moved into the range.
+    /// These bounds and a box where sizes are at most `refine.max_size`; an error says why it is
+    /// not one: corners of different dimensions or not below one another, non-finite
+    /// coordinates, or a size that is not positive or is below the minimum size.
+    pub fn with_box(mut self, refine: RefineBox) -> Result<Self, String> {
+        let RefineBox { lo, hi, max_size } = &refine;
+        if lo.len() != hi.len() || lo.iter().chain(hi).any(|x| !x.is_finite()) {
+            return Err("the box needs two corners of finite coordinates in the same dimensions".into());
+        }
+        if lo.iter().zip(hi).any(|(a, b)| a >= b) {
+            return Err(format!("the corner {lo:?} is not below the corner {hi:?} along every axis"));
+        }
+        if !(max_size.is_finite() && *max_size > 0.0) {
+            return Err(format!("the box's size must be a positive number, not {max_size}"));
+        }
+        if *max_size < self.min {
+            return Err(format!("the box's size {max_size} is below the minimum size {}", self.min));
+        }
+        self.boxes.push(refine);
+        Ok(self)
+    }
+
+    /// The refinement boxes.
+    pub fn boxes(&self) -> &[RefineBox] {
+        &self.boxes
+    }
+
+    /// `h` moved into the range (the boxes aside).
     pub fn clamp(&self, h: f64) -> f64 {
         h.clamp(self.min, self.max)
+    }
+
+    /// `sizes`, one per element of `mesh`, moved into the range, and at most a box's size on
+    /// every element whose bounding box meets the box. Panics if a box is not of dimension `D`
+    /// (callers check it against the geometry).
+    pub fn apply<const D: usize>(&self, mesh: &Mesh<D>, sizes: &mut [f64]) {
+        sizes.iter_mut().for_each(|h| *h = self.clamp(*h));
+        if self.boxes.is_empty() {
+            return;
+        }
+        assert!(self.boxes.iter().all(|b| b.lo.len() == D), "a refinement box of another dimension than the mesh");
+        for (element, h) in mesh.elements().zip(sizes) {
+            let corner = |pick: fn(f64, f64) -> f64, start: f64| {
+                std::array::from_fn::<f64, D, _>(|k| {
+                    element.iter().fold(start, |acc, &v| pick(acc, mesh.vertices()[v as usize][k]))
+                })
+            };
+            let (lo, hi) = (corner(f64::min, f64::INFINITY), corner(f64::max, f64::NEG_INFINITY));
+            for b in &self.boxes {
+                if (0..D).all(|k| lo[k] <= b.hi[k] && hi[k] >= b.lo[k]) {
+                    *h = h.min(b.max_size);
+                }
+            }
+        }
     }
 }
 
@@ -350,7 +411,7 @@ pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
     mesh: &Mesh<D>,
     sizes: &[f64],
     target: usize,
-    bounds: SizeBounds,
+    bounds: &SizeBounds,
     max_elements: usize,
 ) -> Result<Mesh<D>, ProblemError> {
     if target == 0 || target > max_elements {
@@ -369,7 +430,8 @@ pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
     let mut factor = (estimate / target_f).powf(1.0 / D as f64);
     let mut best: Option<Mesh<D>> = None;
     for _ in 0..ELEMENT_COUNT_ATTEMPTS {
-        let scaled = sizes.iter().map(|h| bounds.clamp(h * factor)).collect();
+        let mut scaled: Vec<f64> = sizes.iter().map(|h| h * factor).collect();
+        bounds.apply(mesh, &mut scaled);
         let candidate = domain.remesh(mesh, scaled, max_elements)?;
         let count = candidate.num_elements() as f64;
         let miss = |m: &Mesh<D>| (m.num_elements() as f64 / target_f - 1.0).abs();
@@ -403,16 +465,16 @@ mod tests {
         let sizes: Vec<f64> = mesh.midpoints().iter().map(|x| 0.004 + 0.08 * (x[0] + x[1]) / 2.0).collect();
         let natural = holed.remesh(mesh, sizes.clone(), 1_000_000).unwrap().num_elements();
         for target in [natural / 4, natural, 4 * natural] {
-            let made = mesh_to_element_count(&holed, mesh, &sizes, target, SizeBounds::default(), 1_000_000).unwrap();
+            let made = mesh_to_element_count(&holed, mesh, &sizes, target, &SizeBounds::default(), 1_000_000).unwrap();
             let ratio = made.num_elements() as f64 / target as f64;
             assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements for {target}", made.num_elements());
             assert!((made.total_volume() - 0.96).abs() < 1e-12);
             let near = made.midpoints().iter().filter(|x| x[0] + x[1] < 1.0).count();
             assert!(near > made.num_elements() / 2, "the grading is kept: {near} of {}", made.num_elements());
         }
-        assert!(mesh_to_element_count(&holed, mesh, &sizes, 10, SizeBounds::default(), 5).is_err());
+        assert!(mesh_to_element_count(&holed, mesh, &sizes, 10, &SizeBounds::default(), 5).is_err());
         let broken: Vec<f64> = sizes.iter().map(|_| f64::NAN).collect();
-        assert!(mesh_to_element_count(&holed, mesh, &broken, 100, SizeBounds::default(), 1_000).is_err());
+        assert!(mesh_to_element_count(&holed, mesh, &broken, 100, &SizeBounds::default(), 1_000).is_err());
     }
 
     /// The same graded field (sizes 0.004 to 0.084) held within [0.01, 0.025]: the count still
@@ -429,20 +491,53 @@ mod tests {
             h.sort_by(f64::total_cmp);
             (quantile(&h, 0.02), quantile(&h, 0.98))
         };
-        let unbounded = mesh_to_element_count(&square, mesh, &sizes, 8_000, SizeBounds::default(), 1_000_000).unwrap();
+        let unbounded = mesh_to_element_count(&square, mesh, &sizes, 8_000, &SizeBounds::default(), 1_000_000).unwrap();
         let (low, high) = quantiles(&unbounded);
         assert!(
             low < 0.007 && high > 0.032,
             "the unbounded field leaves the range: 2 % and 98 % quantiles {low}, {high}"
         );
         let bounds = SizeBounds::new(Some(0.01), Some(0.025)).unwrap();
-        let made = mesh_to_element_count(&square, mesh, &sizes, 8_000, bounds, 1_000_000).unwrap();
+        let made = mesh_to_element_count(&square, mesh, &sizes, 8_000, &bounds, 1_000_000).unwrap();
         let ratio = made.num_elements() as f64 / 8_000.0;
         assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements", made.num_elements());
         let (low, high) = quantiles(&made);
         assert!(low > 0.0075 && high < 0.03, "2 % and 98 % quantiles {low}, {high}");
         let near = made.midpoints().iter().filter(|x| x[0] + x[1] < 1.0).count();
         assert!(near > made.num_elements() * 6 / 10, "the grading is kept: {near} of {}", made.num_elements());
+    }
+
+    /// A uniform field with a box asking for a fifth of its size: the count still lands on the
+    /// target, the box's elements have its size, and the rest of the square is coarser.
+    #[test]
+    fn a_refinement_box_holds_its_elements_while_the_count_is_met() {
+        let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![]).unwrap();
+        let square = PlanarPart::new("square".into(), domain, 0.1).unwrap();
+        let mesh = square.initial_mesh();
+        let sizes = vec![0.05; mesh.num_elements()];
+        let refine = RefineBox { lo: vec![0.2, 0.2], hi: vec![0.4, 0.4], max_size: 0.01 };
+        let bounds = SizeBounds::default().with_box(refine).unwrap();
+        let made = mesh_to_element_count(&square, mesh, &sizes, 3_000, &bounds, 1_000_000).unwrap();
+        let ratio = made.num_elements() as f64 / 3_000.0;
+        assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements", made.num_elements());
+        let median_where = |inside: &dyn Fn([f64; 2]) -> bool| {
+            let mut h: Vec<f64> =
+                made.midpoints().iter().zip(made.sizes()).filter(|(x, _)| inside(**x)).map(|(_, h)| h).collect();
+            h.sort_by(f64::total_cmp);
+            quantile(&h, 0.5)
+        };
+        let in_box = median_where(&|x| (0.2..0.4).contains(&x[0]) && (0.2..0.4).contains(&x[1]));
+        let far = median_where(&|x| x[0] > 0.7 && x[1] > 0.7);
+        assert!((0.008..0.012).contains(&in_box), "the box's median size {in_box}");
+        assert!(far > 2.5 * in_box, "far from the box {far}, in it {in_box}");
+
+        let bad = |lo: Vec<f64>, hi: Vec<f64>, max_size| {
+            SizeBounds::new(Some(0.005), None).unwrap().with_box(RefineBox { lo, hi, max_size }).unwrap_err()
+        };
+        assert!(bad(vec![0.0, 0.0], vec![1.0, 1.0, 1.0], 0.01).contains("same dimensions"));
+        assert!(bad(vec![0.0, 1.0], vec![1.0, 0.5], 0.01).contains("not below"));
+        assert!(bad(vec![0.0, 0.0], vec![1.0, 1.0], -1.0).contains("positive"));
+        assert!(bad(vec![0.0, 0.0], vec![1.0, 1.0], 0.001).contains("below the minimum size"));
     }
 
     #[test]

@@ -221,9 +221,10 @@ pub struct GeneratedStep<const D: usize> {
     pub mesh: Mesh<D>,
 }
 
-/// What a user asks of the last step of [`generate`]: an element count, and a range for its
-/// sizes. The default asks nothing: the model's own final step scale decides.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// What a user asks of the last step of [`generate`]: an element count, and a range and
+/// refinement boxes for its sizes. The default asks nothing: the model's own final step scale
+/// decides.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct FinalStep {
     pub target: Option<ElementTarget>,
     pub bounds: SizeBounds,
@@ -257,14 +258,14 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
         let mut field = model.predict(&[domain], &[current])?.pop().expect("one field per domain");
         if step == steps && last.target.is_none() {
             field.scale(model.limits().final_step_scale);
-            field.sizes.iter_mut().for_each(|h| *h = last.bounds.clamp(*h));
+            last.bounds.apply(field.mesh.as_ref().unwrap_or(current), &mut field.sizes);
         }
         let on = field.mesh.as_ref().unwrap_or(current);
         let mesh = match last.target.filter(|_| step == steps) {
             Some(target) => {
                 let min_size = model.limits().min_size;
                 let sizes: Vec<f64> = field.sizes.iter().map(|h| h.max(min_size)).collect();
-                mesh_to_element_count(domain, on, &sizes, target.elements, last.bounds, target.max_elements)
+                mesh_to_element_count(domain, on, &sizes, target.elements, &last.bounds, target.max_elements)
                     .map_err(|e| TrainError::Generation { step, reason: e.to_string() })?
             }
             None => match generation_step(domain, on, field.sizes.clone(), model.limits()) {
