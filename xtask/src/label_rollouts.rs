@@ -13,7 +13,7 @@ use amber_tasks::console::{INITIAL_SIZE, TrainSet, check_data};
 use amber_tasks::folder::{DatasetSettings, Split, problems, read_experts};
 use amber_tasks::part::SolidPart;
 use amber_tasks::poisson::read_split;
-use amber_tasks::{MeshLimits, Problem, StepOutcome, generation_step, labels};
+use amber_tasks::{MeshLimits, Problem, SizeBounds, StepOutcome, generation_step, labels};
 use amber_train::{MeshMetrics, Reference};
 use anyhow::Context;
 use rayon::prelude::*;
@@ -160,7 +160,7 @@ fn roll_out<const D: usize, P: Problem<D> + Sync>(
             };
             for _ in 0..args.steps {
                 let sizes = labels(p, &mesh, args.aggregation).with_context(context)?;
-                match generation_step(p, &mesh, sizes, limits) {
+                match generation_step(p, &mesh, sizes, limits, &SizeBounds::default()) {
                     StepOutcome::Meshed(next) => mesh = next,
                     StepOutcome::OverBudget { .. } | StepOutcome::Failed { .. } => row.failed_steps += 1,
                 }

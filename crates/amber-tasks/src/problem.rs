@@ -263,12 +263,15 @@ pub enum StepOutcome<const D: usize> {
 const BUDGET_TARGET: f64 = 0.95;
 
 /// One generation step from `mesh` with the predicted per-element `sizes`: clip below at h_min,
-/// check the element budget (skip, or scale to it, as `limits` says), mesh.
+/// check the element budget (skip, or scale to it, as `limits` says), hold the field within a
+/// user's `bounds` (after the budget, which guards the model's field: a refinement box adds its
+/// elements rather than coarsening the rest), mesh.
 pub fn generation_step<const D: usize, P: Domain<D> + ?Sized>(
     problem: &P,
     mesh: &Mesh<D>,
     mut sizes: Vec<f64>,
     limits: &MeshLimits,
+    bounds: &SizeBounds,
 ) -> StepOutcome<D> {
     // `f64::max` maps NaN to the minimum: a broken prediction asks for the finest mesh, which
     // the budget then rejects.
@@ -282,6 +285,7 @@ pub fn generation_step<const D: usize, P: Domain<D> + ?Sized>(
         let factor = (estimated_elements / (BUDGET_TARGET * limits.max_elements as f64)).powf(1.0 / D as f64);
         sizes.iter_mut().for_each(|h| *h *= factor);
     }
+    bounds.apply(mesh, &mut sizes);
     let cap = limits.generator_cap();
     match problem.remesh(mesh, sizes, cap) {
         Ok(mesh) => StepOutcome::Meshed(mesh),
@@ -538,6 +542,34 @@ mod tests {
         assert!(bad(vec![0.0, 1.0], vec![1.0, 0.5], 0.01).contains("not below"));
         assert!(bad(vec![0.0, 0.0], vec![1.0, 1.0], -1.0).contains("positive"));
         assert!(bad(vec![0.0, 0.0], vec![1.0, 1.0], 0.001).contains("below the minimum size"));
+    }
+
+    /// A field over the model's budget is scaled to it before a refinement box acts: the box's
+    /// elements keep its size, and only the model's field pays for the budget.
+    #[test]
+    fn a_refinement_box_acts_after_the_budget_guard() {
+        let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![]).unwrap();
+        let square = PlanarPart::new("square".into(), domain, 0.1).unwrap();
+        let mesh = square.initial_mesh();
+        let limits = MeshLimits { min_size: 1e-3, max_elements: 500, scale_to_budget: true, final_step_scale: 1.0 };
+        let refine = RefineBox { lo: vec![0.0, 0.0], hi: vec![0.2, 0.2], max_size: 0.01 };
+        let bounds = SizeBounds::default().with_box(refine).unwrap();
+        // An estimate of 924 elements, about twice the budget, before the box adds about 900.
+        let StepOutcome::Meshed(made) =
+            generation_step(&square, mesh, vec![0.05; mesh.num_elements()], &limits, &bounds)
+        else {
+            panic!("not meshed")
+        };
+        let median_where = |inside: &dyn Fn([f64; 2]) -> bool| {
+            let mut h: Vec<f64> =
+                made.midpoints().iter().zip(made.sizes()).filter(|(x, _)| inside(**x)).map(|(_, h)| h).collect();
+            h.sort_by(f64::total_cmp);
+            quantile(&h, 0.5)
+        };
+        let in_box = median_where(&|x| x[0] < 0.2 && x[1] < 0.2);
+        let far = median_where(&|x| x[0] > 0.6 && x[1] > 0.6);
+        assert!((0.008..0.012).contains(&in_box), "the box's median size {in_box}");
+        assert!((0.06..0.085).contains(&far), "the budget's scale, 0.05 × √(924/475) = 0.070: {far}");
     }
 
     #[test]

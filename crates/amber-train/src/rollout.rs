@@ -193,7 +193,7 @@ pub fn rollouts<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
                 };
                 let Some(field) = field else { return Ok(carried(StepStatus::Stopped)) };
                 let on = field.mesh.as_ref().unwrap_or(previous);
-                Ok(match generation_step(problem, on, field.sizes, model.limits()) {
+                Ok(match generation_step(problem, on, field.sizes, model.limits(), &SizeBounds::default()) {
                     StepOutcome::Meshed(mesh) => {
                         let metrics =
                             MeshMetrics::of(&mesh, problem.expert_mesh(), &references[i]).map_err(in_problem(i))?;
@@ -245,7 +245,8 @@ pub struct ElementTarget {
 /// last step does what `last` asks: with a target, its field keeps its shape and is scaled to
 /// the target's element count (instead of the budget guard): the model decides where elements
 /// go, the user how many; without one, by the model's `final_step_scale`; either way its sizes
-/// are then held within `last.bounds`. A step that makes no mesh is an error naming the step.
+/// are then held within `last.bounds` (after the model's budget guard, see [`generation_step`]).
+/// A step that makes no mesh is an error naming the step.
 pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     model: &M,
     domain: &P,
@@ -253,12 +254,13 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     last: FinalStep,
 ) -> Result<Vec<GeneratedStep<D>>> {
     let mut out: Vec<GeneratedStep<D>> = Vec::with_capacity(steps);
+    let unbounded = SizeBounds::default();
+    let bounds_at = |step| if step == steps { &last.bounds } else { &unbounded };
     for step in 1..=steps {
         let current = out.last().map_or(domain.initial_mesh(), |s| &s.mesh);
         let mut field = model.predict(&[domain], &[current])?.pop().expect("one field per domain");
         if step == steps && last.target.is_none() {
             field.scale(model.limits().final_step_scale);
-            last.bounds.apply(field.mesh.as_ref().unwrap_or(current), &mut field.sizes);
         }
         let on = field.mesh.as_ref().unwrap_or(current);
         let mesh = match last.target.filter(|_| step == steps) {
@@ -268,7 +270,7 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
                 mesh_to_element_count(domain, on, &sizes, target.elements, &last.bounds, target.max_elements)
                     .map_err(|e| TrainError::Generation { step, reason: e.to_string() })?
             }
-            None => match generation_step(domain, on, field.sizes.clone(), model.limits()) {
+            None => match generation_step(domain, on, field.sizes.clone(), model.limits(), bounds_at(step)) {
                 StepOutcome::Meshed(mesh) => mesh,
                 StepOutcome::OverBudget { estimated_elements } => {
                     let reason = format!(

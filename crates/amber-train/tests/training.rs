@@ -239,12 +239,15 @@ fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
         amber_tasks::MeshLimits { min_size: 1e-6, max_elements: 2_000, scale_to_budget: false, final_step_scale: 1.0 };
     // 0.005 everywhere asks for ~70k triangles on the L-shape.
     let fine = vec![0.005; m0.num_elements()];
-    let outcome = amber_tasks::generation_step(&problem, &m0, fine.clone(), &limits);
+    let outcome =
+        amber_tasks::generation_step(&problem, &m0, fine.clone(), &limits, &amber_tasks::SizeBounds::default());
     assert!(
         matches!(outcome, amber_tasks::StepOutcome::OverBudget { estimated_elements } if estimated_elements > 50_000.0)
     );
     limits.scale_to_budget = true;
-    let amber_tasks::StepOutcome::Meshed(mesh) = amber_tasks::generation_step(&problem, &m0, fine, &limits) else {
+    let amber_tasks::StepOutcome::Meshed(mesh) =
+        amber_tasks::generation_step(&problem, &m0, fine, &limits, &amber_tasks::SizeBounds::default())
+    else {
         panic!("a field scaled to the budget is meshed")
     };
     let n = mesh.num_elements();

@@ -98,7 +98,7 @@ mod tests {
     use super::*;
     use crate::folder::{DatasetSettings, problems, read_experts};
     use crate::part::SolidPart;
-    use crate::problem::{Domain, MeshLimits, MeshState, Problem, StepOutcome, generation_step, labels};
+    use crate::problem::{Domain, MeshLimits, MeshState, Problem, SizeBounds, StepOutcome, generation_step, labels};
 
     #[test]
     fn initial_size_is_the_regular_tet_of_ten_cubic_millimetres() {
@@ -189,7 +189,9 @@ mod tests {
         assert!(problem.domain.surface.is_validated());
 
         let limits = MeshLimits::from_experts([problem.expert_mesh()], 1.2, 0.005);
-        let StepOutcome::Meshed(mesh) = generation_step(&problem, m0, vec![3.0; m0.num_elements()], &limits) else {
+        let StepOutcome::Meshed(mesh) =
+            generation_step(&problem, m0, vec![3.0; m0.num_elements()], &limits, &SizeBounds::default())
+        else {
             panic!("the 3 mm step was not meshed")
         };
         let expected = volume / amber_mesh::volume_from_size::<3>(3.0);
@@ -199,7 +201,7 @@ mod tests {
         assert_eq!(state.graph.num_nodes(), state.mesh.num_elements());
         let y = labels(&problem, &state.mesh, Aggregation::Mean).unwrap();
         assert!(y.len() == state.mesh.num_elements() && y.iter().all(|h| h.is_finite() && *h > 0.0));
-        let outcome = generation_step(&problem, m0, vec![0.05; m0.num_elements()], &limits);
+        let outcome = generation_step(&problem, m0, vec![0.05; m0.num_elements()], &limits, &SizeBounds::default());
         assert!(matches!(outcome, StepOutcome::OverBudget { .. }), "{outcome:?}");
     }
 }

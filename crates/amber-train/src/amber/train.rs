@@ -11,7 +11,8 @@ use amber_mesh::Mesh;
 use amber_mpn::{Mpn, MpnConfig, MpnTrainer};
 use amber_stdx::{read_json, write_json_atomic};
 use amber_tasks::{
-    LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, StepOutcome, generation_step, labels, with_inputs,
+    LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, SizeBounds, StepOutcome, generation_step, labels,
+    with_inputs,
 };
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -314,7 +315,13 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         let entry = self.buffer.get(source);
         let (problem, depth) = (entry.problem, entry.depth + 1);
         let sizes = self.predictor.predict(self.trainer.network(), &[&entry.sample.state])?.pop().expect("one state");
-        let outcome = generation_step(&self.problems[problem], &entry.sample.state.mesh, sizes, &self.predictor.limits);
+        let outcome = generation_step(
+            &self.problems[problem],
+            &entry.sample.state.mesh,
+            sizes,
+            &self.predictor.limits,
+            &SizeBounds::default(),
+        );
         Ok(match outcome {
             StepOutcome::Meshed(mesh) => {
                 let sample = self.sample(&self.problems[problem], mesh).map_err(in_problem(problem))?;
