@@ -511,6 +511,14 @@ mod tests {
         assert!(near > made.num_elements() * 6 / 10, "the grading is kept: {near} of {}", made.num_elements());
     }
 
+    /// The median element size of `mesh` over the elements whose midpoint is `inside`.
+    fn median_size_where(mesh: &Mesh<2>, inside: impl Fn([f64; 2]) -> bool) -> f64 {
+        let mut h: Vec<f64> =
+            mesh.midpoints().iter().zip(mesh.sizes()).filter(|(x, _)| inside(**x)).map(|(_, h)| h).collect();
+        h.sort_by(f64::total_cmp);
+        quantile(&h, 0.5)
+    }
+
     /// A uniform field with a box asking for a fifth of its size: the count still lands on the
     /// target, the box's elements have its size, and the rest of the square is coarser.
     #[test]
@@ -524,14 +532,8 @@ mod tests {
         let made = mesh_to_element_count(&square, mesh, &sizes, 3_000, &bounds, 1_000_000).unwrap();
         let ratio = made.num_elements() as f64 / 3_000.0;
         assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements", made.num_elements());
-        let median_where = |inside: &dyn Fn([f64; 2]) -> bool| {
-            let mut h: Vec<f64> =
-                made.midpoints().iter().zip(made.sizes()).filter(|(x, _)| inside(**x)).map(|(_, h)| h).collect();
-            h.sort_by(f64::total_cmp);
-            quantile(&h, 0.5)
-        };
-        let in_box = median_where(&|x| (0.2..0.4).contains(&x[0]) && (0.2..0.4).contains(&x[1]));
-        let far = median_where(&|x| x[0] > 0.7 && x[1] > 0.7);
+        let in_box = median_size_where(&made, |x| (0.2..0.4).contains(&x[0]) && (0.2..0.4).contains(&x[1]));
+        let far = median_size_where(&made, |x| x[0] > 0.7 && x[1] > 0.7);
         assert!((0.008..0.012).contains(&in_box), "the box's median size {in_box}");
         assert!(far > 2.5 * in_box, "far from the box {far}, in it {in_box}");
 
@@ -560,14 +562,8 @@ mod tests {
         else {
             panic!("not meshed")
         };
-        let median_where = |inside: &dyn Fn([f64; 2]) -> bool| {
-            let mut h: Vec<f64> =
-                made.midpoints().iter().zip(made.sizes()).filter(|(x, _)| inside(**x)).map(|(_, h)| h).collect();
-            h.sort_by(f64::total_cmp);
-            quantile(&h, 0.5)
-        };
-        let in_box = median_where(&|x| x[0] < 0.2 && x[1] < 0.2);
-        let far = median_where(&|x| x[0] > 0.6 && x[1] > 0.6);
+        let in_box = median_size_where(&made, |x| x[0] < 0.2 && x[1] < 0.2);
+        let far = median_size_where(&made, |x| x[0] > 0.6 && x[1] > 0.6);
         assert!((0.008..0.012).contains(&in_box), "the box's median size {in_box}");
         assert!((0.06..0.085).contains(&far), "the budget's scale, 0.05 × √(924/475) = 0.070: {far}");
     }
