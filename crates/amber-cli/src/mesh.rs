@@ -1,6 +1,7 @@
 //! `amber mesh`: a geometry in, a mesh out, its sizes from a trained model (`--model`) or a given
 //! sizing field (`--size`).
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -22,7 +23,7 @@ use amber_tasks::part::{
     read_solid_surface,
 };
 use amber_tasks::poisson::{PoissonPart, read_part};
-use amber_tasks::{Domain, RefineBox, SizeBounds, WithExpert};
+use amber_tasks::{Domain, RefineBox, RefineFace, SizeBounds, WithExpert};
 use amber_train::{ElementTarget, FinalStep, GeneratedStep, MeshMetrics, Reference, TrainError, TrainedModel};
 use anyhow::{Context, bail};
 use clap::Args;
@@ -69,6 +70,14 @@ pub struct MeshArgs {
     /// beyond it); --elements counts the box's elements in. May be given more than once.
     #[arg(long, requires = "model", value_parser = parse_refine_box, value_name = "CORNERS,SIZE", allow_hyphen_values = true)]
     refine_box: Vec<RefineBox>,
+    /// A piece of the boundary where the final mesh's elements are to be no larger than SIZE (a
+    /// contact face, a hole's wall, a loaded edge): `FACE,SIZE`, FACE the number of a CAD face of
+    /// a solid or of a side of a polygon, as in the written mesh's `boundary_<FACE>` groups. The
+    /// last step's field is held at SIZE on every element of the mesh before it with a vertex on
+    /// the face, a layer as deep as that mesh's elements there; --elements counts them in. May
+    /// be given more than once.
+    #[arg(long, requires = "model", value_parser = parse_refine_face, value_name = "FACE,SIZE")]
+    refine_face: Vec<RefineFace>,
     /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,
     /// and its domain when no geometry is given; its expert mesh, when present, is the default
     /// --expert), or a part's inputs (`<stem>.inputs.json`: named numbers and points) for a model
@@ -236,6 +245,19 @@ where
             anyhow::bail!("--refine-box: a box of {} dimensions for a {D}D geometry", refine.lo.len());
         }
         bounds = bounds.with_box(refine.clone()).map_err(|e| anyhow::anyhow!("--refine-box: {e}"))?;
+    }
+    if !args.refine_face.is_empty() {
+        let faces: BTreeSet<i32> = domain.boundary_tags(domain.initial_mesh()).into_values().collect();
+        for refine in &args.refine_face {
+            if !faces.contains(&refine.face) {
+                anyhow::bail!(
+                    "--refine-face: the geometry has no face {}; its faces are {}",
+                    refine.face,
+                    face_list(&faces)
+                );
+            }
+            bounds = bounds.with_face(refine.clone()).map_err(|e| anyhow::anyhow!("--refine-face: {e}"))?;
+        }
     }
     let generated = model.generate(&domain, steps, FinalStep { target, bounds }).map_err(|e| match e {
         TrainError::MissingInputs(_) => anyhow::anyhow!("{e}: give the part's inputs with --problem FILE.inputs.json"),
@@ -470,6 +492,31 @@ fn parse_refine_box(text: &str) -> Result<RefineBox, String> {
             "expected X0,Y0,X1,Y1,SIZE (2D) or X0,Y0,Z0,X1,Y1,Z1,SIZE (3D), comma-separated numbers, got `{text}`"
         )),
     }
+}
+
+fn parse_refine_face(text: &str) -> Result<RefineFace, String> {
+    match text.split_once(',').map(|(face, size)| (face.trim().parse::<i32>(), size.trim().parse::<f64>())) {
+        Some((Ok(face), Ok(max_size))) => Ok(RefineFace { face, max_size }),
+        _ => Err(format!("expected FACE,SIZE (a face number and a size, like 3,0.5), got `{text}`")),
+    }
+}
+
+/// `faces` for a message: `none (the boundary is one piece)`, or the numbers, runs shortened to
+/// `first–last`.
+fn face_list(faces: &BTreeSet<i32>) -> String {
+    if faces.is_empty() {
+        return "none (the boundary is one piece)".into();
+    }
+    let mut runs: Vec<(i32, i32)> = Vec::new();
+    for &face in faces {
+        match runs.last_mut() {
+            Some((_, last)) if *last + 1 == face => *last = face,
+            _ => runs.push((face, face)),
+        }
+    }
+    let runs: Vec<String> =
+        runs.iter().map(|&(a, b)| if a == b { a.to_string() } else { format!("{a}–{b}") }).collect();
+    runs.join(", ")
 }
 
 fn parse_point(text: &str) -> Result<[f64; 2], String> {

@@ -240,6 +240,43 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
         );
     }
 
+    // A refined face: the elements along one side of the square (face 1, the outer ring's first
+    // side) take its size, the other outer sides keep theirs. A face the geometry lacks is an
+    // error listing the faces it has.
+    let side_medians = |knobs: &[&str]| {
+        let output = mesh_square(knobs);
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        let mesh = amber_mesh::read_mesh::<2>(&final_mesh).unwrap();
+        // The middle thirds: a corner's elements, finer on one side, would weigh on the other's.
+        let middle = |t: f64| (0.33..0.67).contains(&t);
+        let sides: [&dyn Fn([f64; 2]) -> bool; 4] = [
+            &|x| x[1] < 0.04 && middle(x[0]),
+            &|x| x[0] > 0.96 && middle(x[1]),
+            &|x| x[1] > 0.96 && middle(x[0]),
+            &|x| x[0] < 0.04 && middle(x[1]),
+        ];
+        sides.map(|inside| {
+            let mut h: Vec<f64> =
+                mesh.midpoints().iter().zip(mesh.sizes()).filter(|(x, _)| inside(**x)).map(|(_, h)| h).collect();
+            h.sort_by(f64::total_cmp);
+            h[h.len() / 2]
+        })
+    };
+    let before = side_medians(&range);
+    let after = side_medians(&[&range[..], &["--refine-face", "1,0.02"]].concat());
+    let refined: Vec<usize> = (0..4).filter(|&k| after[k] < 0.025 && after[k] < 0.8 * before[k]).collect();
+    assert_eq!(refined.len(), 1, "side medians {after:?}, without the face {before:?}");
+    let opposite = (refined[0] + 2) % 4;
+    assert!((after[opposite] / before[opposite] - 1.0).abs() < 0.15, "{after:?}, without the face {before:?}");
+    for (refine, expected) in [("99,0.02", "its faces are 1–8"), ("1", "FACE,SIZE"), ("1,-0.5", "positive")] {
+        let output = mesh_square(&["--refine-face", refine]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && stderr.contains("--refine-face") && stderr.contains(expected),
+            "{refine}: {stderr}"
+        );
+    }
+
     // A missing model, or a Poisson model without its load, is an error with a message.
     for args in [vec!["--model", "/nonexistent", "--problem"], vec!["square", "--model"]] {
         let mut command = amber();

@@ -24,5 +24,5 @@ mod problem;
 pub use error::TaskError;
 pub use problem::{
     Column, Domain, ELEMENT_COUNT_TOLERANCE, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, RefineBox,
-    SizeBounds, StepOutcome, WithExpert, generation_step, labels, mesh_to_element_count, with_inputs,
+    RefineFace, SizeBounds, StepOutcome, WithExpert, generation_step, labels, mesh_to_element_count, with_inputs,
 };

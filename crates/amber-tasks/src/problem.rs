@@ -285,7 +285,7 @@ pub fn generation_step<const D: usize, P: Domain<D> + ?Sized>(
         let factor = (estimated_elements / (BUDGET_TARGET * limits.max_elements as f64)).powf(1.0 / D as f64);
         sizes.iter_mut().for_each(|h| *h *= factor);
     }
-    bounds.apply(mesh, &mut sizes);
+    bounds.apply(problem, mesh, &mut sizes);
     let cap = limits.generator_cap();
     match problem.remesh(mesh, sizes, cap) {
         Ok(mesh) => StepOutcome::Meshed(mesh),
@@ -303,16 +303,18 @@ pub const ELEMENT_COUNT_TOLERANCE: f64 = 0.05;
 /// Meshings [`mesh_to_element_count`] tries before it returns its closest mesh.
 const ELEMENT_COUNT_ATTEMPTS: usize = 5;
 
-/// What a user allows a final mesh's sizing field (`amber mesh --min-size/--max-size/--refine-box`):
-/// a range (an explicit solver's time step is set by its smallest element; a contact or a result
-/// plot wants no element above a size) and boxes where elements are to be no larger than a size
-/// (a bolt hole, a weld, where the stresses matter). They act after every other scaling, so the
-/// model still decides where elements go within them.
+/// What a user allows a final mesh's sizing field (`amber mesh --min-size/--max-size/--refine-box/
+/// --refine-face`): a range (an explicit solver's time step is set by its smallest element; a
+/// contact or a result plot wants no element above a size), and boxes and boundary faces where
+/// elements are to be no larger than a size (a bolt hole, a weld, a contact face: where the
+/// stresses matter). They act after every other scaling, so the model still decides where
+/// elements go within them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SizeBounds {
     min: f64,
     max: f64,
     boxes: Vec<RefineBox>,
+    faces: Vec<RefineFace>,
 }
 
 /// An axis-aligned box (corners `lo`, `hi` in the geometry's `lo.len()` dimensions) where the
@@ -324,10 +326,19 @@ pub struct RefineBox {
     pub max_size: f64,
 }
 
+/// A piece of the boundary (a solid's CAD face, a polygon's side: the tag of
+/// [`Domain::boundary_tags`], the `boundary_<face>` group of the written mesh) where the sizing
+/// field is held at or below `max_size`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefineFace {
+    pub face: i32,
+    pub max_size: f64,
+}
+
 impl Default for SizeBounds {
     /// No bounds.
     fn default() -> Self {
-        Self { min: 0.0, max: f64::INFINITY, boxes: Vec::new() }
+        Self { min: 0.0, max: f64::INFINITY, boxes: Vec::new(), faces: Vec::new() }
     }
 }
 
@@ -340,7 +351,7 @@ impl SizeBounds {
                 return Err(format!("the {name} size must be a positive number, not {h}"));
             }
         }
-        let bounds = Self { min: min.unwrap_or(0.0), max: max.unwrap_or(f64::INFINITY), boxes: Vec::new() };
+        let bounds = Self { min: min.unwrap_or(0.0), max: max.unwrap_or(f64::INFINITY), ..Self::default() };
         if bounds.min > bounds.max {
             return Err(format!("the minimum size {} is above the maximum size {}", bounds.min, bounds.max));
         }
@@ -358,14 +369,28 @@ impl SizeBounds {
         if lo.iter().zip(hi).any(|(a, b)| a >= b) {
             return Err(format!("the corner {lo:?} is not below the corner {hi:?} along every axis"));
         }
-        if !(max_size.is_finite() && *max_size > 0.0) {
-            return Err(format!("the box's size must be a positive number, not {max_size}"));
-        }
-        if *max_size < self.min {
-            return Err(format!("the box's size {max_size} is below the minimum size {}", self.min));
-        }
+        self.check_refined_size("box", *max_size)?;
         self.boxes.push(refine);
         Ok(self)
+    }
+
+    /// These bounds and a boundary face where sizes are at most `refine.max_size`; an error says
+    /// why the size is not one (as for a box). Whether the geometry has the face is the caller's
+    /// to check, against [`Domain::boundary_tags`].
+    pub fn with_face(mut self, refine: RefineFace) -> Result<Self, String> {
+        self.check_refined_size("face", refine.max_size)?;
+        self.faces.push(refine);
+        Ok(self)
+    }
+
+    fn check_refined_size(&self, what: &str, max_size: f64) -> Result<(), String> {
+        if !(max_size.is_finite() && max_size > 0.0) {
+            return Err(format!("the {what}'s size must be a positive number, not {max_size}"));
+        }
+        if max_size < self.min {
+            return Err(format!("the {what}'s size {max_size} is below the minimum size {}", self.min));
+        }
+        Ok(())
     }
 
     /// The refinement boxes.
@@ -373,16 +398,37 @@ impl SizeBounds {
         &self.boxes
     }
 
+    /// The refined boundary faces.
+    pub fn faces(&self) -> &[RefineFace] {
+        &self.faces
+    }
+
     /// `h` moved into the range (the boxes aside).
     pub fn clamp(&self, h: f64) -> f64 {
         h.clamp(self.min, self.max)
     }
 
-    /// `sizes`, one per element of `mesh`, moved into the range, and at most a box's size on
-    /// every element whose bounding box meets the box. Panics if a box is not of dimension `D`
-    /// (callers check it against the geometry).
-    pub fn apply<const D: usize>(&self, mesh: &Mesh<D>, sizes: &mut [f64]) {
+    /// `sizes`, one per element of `mesh` (a mesh of `domain`), moved into the range; at most a
+    /// box's size on every element whose bounding box meets the box, and a face's size on every
+    /// element with a vertex on the face. Panics if a box is not of dimension `D` (callers check
+    /// it against the geometry).
+    pub fn apply<const D: usize, P: Domain<D> + ?Sized>(&self, domain: &P, mesh: &Mesh<D>, sizes: &mut [f64]) {
         sizes.iter_mut().for_each(|h| *h = self.clamp(*h));
+        if !self.faces.is_empty() {
+            // The smallest size any refined face asks of each vertex.
+            let mut vertex_size = vec![f64::INFINITY; mesh.num_vertices()];
+            for (facet, tag) in domain.boundary_tags(mesh) {
+                for refine in self.faces.iter().filter(|f| f.face == tag) {
+                    for &v in &facet {
+                        let h = &mut vertex_size[v as usize];
+                        *h = h.min(refine.max_size);
+                    }
+                }
+            }
+            for (element, h) in mesh.elements().zip(sizes.iter_mut()) {
+                *h = element.iter().fold(*h, |h, &v| h.min(vertex_size[v as usize]));
+            }
+        }
         if self.boxes.is_empty() {
             return;
         }
@@ -405,11 +451,14 @@ impl SizeBounds {
 
 /// A new mesh of `domain` whose sizes follow the shape of the field `sizes` on `mesh`, scaled by
 /// one factor (then held within `bounds`) so that the mesh has about `target` elements: the budget
-/// knob of `amber mesh --elements`. Bounds that forbid the count leave the closest mesh they allow. The first factor makes the estimate Σ|K|/V(h) equal `target`; the generator's
-/// count differs from the estimate (boundary grading, quality refinement, the 3D curvature cap), so
-/// each further attempt corrects the factor by (n/target)^(1/D) from the count n it got, until n is
-/// within [`ELEMENT_COUNT_TOLERANCE`] of `target` or [`ELEMENT_COUNT_ATTEMPTS`] meshings are spent;
-/// the mesh closest to `target` is returned. `max_elements` caps every meshing.
+/// knob of `amber mesh --elements`. Bounds that forbid the count leave the closest mesh they
+/// allow. The first factor makes the estimate Σ|K|/V(h) equal `target`; the generator's count
+/// differs from the estimate (boundary grading, quality refinement, the 3D curvature cap), so each
+/// further attempt corrects the factor from the count n it got: by (n/target)^(1/D) at first,
+/// then along the slope the last two meshings measured (bounds hold part of the field fixed),
+/// until n is within [`ELEMENT_COUNT_TOLERANCE`] of `target` or [`ELEMENT_COUNT_ATTEMPTS`]
+/// meshings are spent; the mesh closest to `target` is returned. `max_elements` caps every
+/// meshing.
 pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
     domain: &P,
     mesh: &Mesh<D>,
@@ -433,9 +482,10 @@ pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
     let target_f = target as f64;
     let mut factor = (estimate / target_f).powf(1.0 / D as f64);
     let mut best: Option<Mesh<D>> = None;
+    let mut previous: Option<(f64, f64)> = None;
     for _ in 0..ELEMENT_COUNT_ATTEMPTS {
         let mut scaled: Vec<f64> = sizes.iter().map(|h| h * factor).collect();
-        bounds.apply(mesh, &mut scaled);
+        bounds.apply(domain, mesh, &mut scaled);
         let candidate = domain.remesh(mesh, scaled, max_elements)?;
         let count = candidate.num_elements() as f64;
         let miss = |m: &Mesh<D>| (m.num_elements() as f64 / target_f - 1.0).abs();
@@ -446,7 +496,15 @@ pub fn mesh_to_element_count<const D: usize, P: Domain<D> + ?Sized>(
         if done {
             break;
         }
-        factor *= (count / target_f).powf(1.0 / D as f64);
+        // The count goes as factor^-D where the field is free; the bounds hold part of it fixed,
+        // so after two meshings the slope of ln count over ln factor is measured instead (kept
+        // within [-2D, -D/10], so that a step stays bounded where the bounds fix nearly all).
+        let point = (factor.ln(), count.ln());
+        let slope = previous
+            .filter(|(f, _)| (point.0 - f).abs() > 1e-9)
+            .map_or(-(D as f64), |(f, c)| ((point.1 - c) / (point.0 - f)).clamp(-2.0 * D as f64, -0.1 * D as f64));
+        factor *= ((target_f.ln() - point.1) / slope).exp();
+        previous = Some(point);
     }
     Ok(best.expect("at least one attempt"))
 }
@@ -544,6 +602,36 @@ mod tests {
         assert!(bad(vec![0.0, 1.0], vec![1.0, 0.5], 0.01).contains("not below"));
         assert!(bad(vec![0.0, 0.0], vec![1.0, 1.0], -1.0).contains("positive"));
         assert!(bad(vec![0.0, 0.0], vec![1.0, 1.0], 0.001).contains("below the minimum size"));
+    }
+
+    /// A uniform field with the square's bottom side asking for a fifth of its size: the count
+    /// still lands on the target, the elements along that side have its size, the other sides'
+    /// do not, and a face's size is checked as a box's.
+    #[test]
+    fn a_refined_face_holds_its_elements_while_the_count_is_met() {
+        let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![]).unwrap();
+        let square = PlanarPart::new("square".into(), domain, 0.1).unwrap();
+        let mesh = square.initial_mesh();
+        let bottom = square
+            .boundary_tags(mesh)
+            .iter()
+            .find(|(edge, _)| edge.iter().all(|&v| mesh.vertices()[v as usize][1] == 0.0))
+            .map(|(_, &tag)| tag)
+            .unwrap();
+        let bounds = SizeBounds::default().with_face(RefineFace { face: bottom, max_size: 0.01 }).unwrap();
+        let made =
+            mesh_to_element_count(&square, mesh, &vec![0.05; mesh.num_elements()], 3_000, &bounds, 1_000_000).unwrap();
+        let ratio = made.num_elements() as f64 / 3_000.0;
+        assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements", made.num_elements());
+        let along = median_size_where(&made, |x| x[1] < 0.03);
+        let top = median_size_where(&made, |x| x[1] > 0.97);
+        assert!((0.008..0.012).contains(&along), "the bottom side's median size {along}");
+        assert!(top > 2.5 * along, "along the top side {top}, the bottom {along}");
+
+        let bounds = SizeBounds::new(Some(0.005), None).unwrap();
+        let bad = |max_size| bounds.clone().with_face(RefineFace { face: bottom, max_size }).unwrap_err();
+        assert!(bad(f64::NAN).contains("positive"));
+        assert!(bad(0.001).contains("below the minimum size"));
     }
 
     /// A field over the model's budget is scaled to it before a refinement box acts: the box's
