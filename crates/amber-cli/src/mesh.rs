@@ -1,7 +1,7 @@
 //! `amber mesh`: a geometry in, a mesh out, its sizes from a trained model (`--model`) or a given
 //! sizing field (`--size`).
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -24,7 +24,7 @@ use amber_tasks::part::{
 };
 use amber_tasks::poisson::{PoissonPart, read_part};
 use amber_tasks::{Domain, RefineBox, RefineFace, SizeBounds, WithExpert};
-use amber_train::{ElementTarget, FinalStep, GeneratedStep, MeshMetrics, Reference, TrainError, TrainedModel};
+use amber_train::{FinalStep, GeneratedStep, MeshMetrics, Reference, TrainError, TrainedModel};
 use anyhow::{Context, bail};
 use clap::Args;
 
@@ -95,23 +95,36 @@ pub struct MeshArgs {
     /// sharper than this many degrees.
     #[arg(long, default_value_t = FEATURE_ANGLE_DEGREES)]
     feature_angle: f64,
-    /// Refuse to build more elements than this.
+    /// Refuse to build more elements than this. A model's own field is first held to the model's
+    /// element budget; what --elements, the size range and the refinements ask for beyond it is
+    /// capped by this.
     #[arg(long, default_value_t = 5_000_000)]
     max_elements: usize,
     /// Output: .vtu (ParaView), .msh (gmsh 4.1, one physical group per CAD face), .inp (Abaqus),
     /// .nas (NASTRAN), .vtk, .mesh (medit), .json, or .png (a picture coloured by element size).
-    #[arg(short, long)]
-    output: PathBuf,
+    #[arg(short, long, required_unless_present = "list_faces")]
+    output: Option<PathBuf>,
+    /// Print the pieces of the geometry's boundary that --refine-face and the written mesh's
+    /// `boundary_<FACE>` groups number (CAD faces of a solid, sides of a polygon), each with its
+    /// area (length in 2D), centre and bounding box, as the model meshes the geometry; mesh nothing.
+    #[arg(long, requires = "model")]
+    list_faces: bool,
     /// Element order of the output: 1, or 2 for 10-node tetrahedra and 6-node triangles (edge
     /// nodes at the edges' midpoints; .msh, .vtu, .vtk, .nas, .inp).
     #[arg(long, default_value = "1", value_parser = crate::convert::parse_order)]
     order: ElementOrder,
 }
 
+impl MeshArgs {
+    fn output(&self) -> &Path {
+        self.output.as_deref().expect("clap requires --output without --list-faces")
+    }
+}
+
 pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     // A format that cannot take the output fails now, not after the meshing.
-    if args.output.extension().and_then(|e| e.to_str()) != Some("png") {
-        check_output(&args.output, output_options(&args))?;
+    if let Some(output) = args.output.as_deref().filter(|o| o.extension().and_then(|e| e.to_str()) != Some("png")) {
+        check_output(output, output_options(&args))?;
     }
     match &args.model {
         Some(model) => with_model(&args, model),
@@ -236,10 +249,14 @@ fn mesh_domain<const D: usize, P: Domain<D>>(
 where
     Mesh<D>: Picture,
 {
+    if args.list_faces {
+        print_faces(&domain);
+        return Ok(());
+    }
     let start = Instant::now();
-    let target = args.elements.map(|elements| ElementTarget { elements, max_elements: args.max_elements });
-    let mut bounds =
-        SizeBounds::new(args.min_size, args.max_size).map_err(|e| anyhow::anyhow!("--min-size/--max-size: {e}"))?;
+    let mut bounds = SizeBounds::new(args.min_size, args.max_size)
+        .map_err(|e| anyhow::anyhow!("--min-size/--max-size: {e}"))?
+        .with_max_elements(args.max_elements);
     for refine in &args.refine_box {
         if refine.lo.len() != D {
             anyhow::bail!("--refine-box: a box of {} dimensions for a {D}D geometry", refine.lo.len());
@@ -259,10 +276,16 @@ where
             bounds = bounds.with_face(refine.clone()).map_err(|e| anyhow::anyhow!("--refine-face: {e}"))?;
         }
     }
-    let generated = model.generate(&domain, steps, FinalStep { target, bounds }).map_err(|e| match e {
-        TrainError::MissingInputs(_) => anyhow::anyhow!("{e}: give the part's inputs with --problem FILE.inputs.json"),
-        e => e.into(),
-    })?;
+    let generated =
+        model.generate(&domain, steps, FinalStep { elements: args.elements, bounds }).map_err(|e| match e {
+            TrainError::MissingInputs(_) => {
+                anyhow::anyhow!("{e}: give the part's inputs with --problem FILE.inputs.json")
+            }
+            TrainError::OverCap { .. } => {
+                anyhow::anyhow!("{e} (--max-elements): raise it, or ask for fewer or larger elements")
+            }
+            e => e.into(),
+        })?;
     let seconds = start.elapsed().as_secs_f64();
     let last = &generated.last().expect("at least one step").mesh;
     // The boundary grouped by CAD face, for a solver's boundary conditions.
@@ -311,7 +334,7 @@ where
             s.median, s.p10, s.p90
         );
     }
-    eprintln!("{steps} steps in {seconds:.2} s; wrote {}", args.output.display());
+    eprintln!("{steps} steps in {seconds:.2} s; wrote {}", args.output().display());
     Ok(())
 }
 
@@ -405,7 +428,7 @@ where
             mesh.num_elements()
         );
     }
-    let output = &args.output;
+    let output = args.output();
     match output.extension().and_then(|e| e.to_str()) {
         Some("png") => {
             let options = RenderOptions { title: Some("element size h".into()), log_scale: true, ..Default::default() };
@@ -435,7 +458,7 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
             "{} tetrahedra in {:.3} s; wrote {}",
             mesh.num_elements(),
             start.elapsed().as_secs_f64(),
-            args.output.display()
+            args.output().display()
         );
         return Ok(());
     }
@@ -458,7 +481,7 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
         report.size_ratio_p10,
         report.size_ratio_p90,
         report.mean_min_angle,
-        args.output.display()
+        args.output().display()
     );
     Ok(())
 }
@@ -491,6 +514,69 @@ fn parse_refine_box(text: &str) -> Result<RefineBox, String> {
         _ => Err(format!(
             "expected X0,Y0,X1,Y1,SIZE (2D) or X0,Y0,Z0,X1,Y1,Z1,SIZE (3D), comma-separated numbers, got `{text}`"
         )),
+    }
+}
+
+/// Prints each piece of `domain`'s boundary (its tag, as M⁰'s boundary facets carry it) with its
+/// area (length in 2D), centre and bounding box, on standard output.
+fn print_faces<const D: usize, P: Domain<D>>(domain: &P) {
+    /// A face's measure, measure-weighted sum of facet centroids, and corners of its box.
+    struct Face<const D: usize> {
+        measure: f64,
+        weighted: [f64; D],
+        lo: [f64; D],
+        hi: [f64; D],
+    }
+    let mesh = domain.initial_mesh();
+    let mut faces: BTreeMap<i32, Face<D>> = BTreeMap::new();
+    for (facet, tag) in domain.boundary_tags(mesh) {
+        let corners: Vec<[f64; D]> = facet.iter().map(|&v| mesh.vertices()[v as usize]).collect();
+        let measure = simplex_measure(&corners);
+        let face = faces.entry(tag).or_insert(Face {
+            measure: 0.0,
+            weighted: [0.0; D],
+            lo: [f64::INFINITY; D],
+            hi: [f64::NEG_INFINITY; D],
+        });
+        face.measure += measure;
+        for p in &corners {
+            for (k, &x) in p.iter().enumerate() {
+                face.weighted[k] += measure * x / corners.len() as f64;
+                face.lo[k] = face.lo[k].min(x);
+                face.hi[k] = face.hi[k].max(x);
+            }
+        }
+    }
+    if faces.is_empty() {
+        println!("the boundary is one piece: no faces to refine");
+        return;
+    }
+    let what = if D == 3 { "area" } else { "length" };
+    let point = |p: [f64; D]| p.map(|x| format!("{x:.4}")).join(", ");
+    for (tag, face) in faces {
+        let centre = face.weighted.map(|x| x / face.measure);
+        println!(
+            "face {tag}: {what} {:.4}, centre ({}), box ({}) to ({})",
+            face.measure,
+            point(centre),
+            point(face.lo),
+            point(face.hi)
+        );
+    }
+}
+
+/// The length of a segment (2 corners) or the area of a triangle (3 corners).
+fn simplex_measure<const D: usize>(corners: &[[f64; D]]) -> f64 {
+    let edge =
+        |a: [f64; D], b: [f64; D]| -> [f64; 3] { std::array::from_fn(|k| if k < D { b[k] - a[k] } else { 0.0 }) };
+    let u = edge(corners[0], corners[1]);
+    match corners.len() {
+        2 => u.iter().map(|x| x * x).sum::<f64>().sqrt(),
+        _ => {
+            let v = edge(corners[0], corners[2]);
+            let cross = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+            0.5 * cross.iter().map(|x| x * x).sum::<f64>().sqrt()
+        }
     }
 }
 
@@ -555,6 +641,12 @@ mod tests {
     use amber_mesh::Mesh2;
 
     use super::*;
+
+    #[test]
+    fn facets_measure_their_length_or_area() {
+        assert_eq!(simplex_measure(&[[0.0, 0.0], [3.0, 4.0]]), 5.0);
+        assert_eq!(simplex_measure(&[[1.0, 0.0, 0.0], [1.0, 2.0, 0.0], [1.0, 0.0, 3.0]]), 3.0);
+    }
 
     #[test]
     fn slivers_are_counted_as_degenerate() {

@@ -268,6 +268,26 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
     assert_eq!(refined.len(), 1, "side medians {after:?}, without the face {before:?}");
     let opposite = (refined[0] + 2) % 4;
     assert!((after[opposite] / before[opposite] - 1.0).abs() < 0.15, "{after:?}, without the face {before:?}");
+    // The faces to choose from: the square's four sides and the hole's four, with their lengths.
+    let output = mesh_square(&["--list-faces"]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let listed = String::from_utf8_lossy(&output.stdout);
+    let lengths: Vec<f64> = listed
+        .lines()
+        .map(|line| line.split("length ").nth(1).and_then(|rest| rest.split(',').next()).unwrap().parse().unwrap())
+        .collect();
+    assert!(listed.starts_with("face 1: ") && listed.contains("face 8: "), "{listed}");
+    assert_eq!(lengths.iter().map(|l| (l * 10.0).round() as i64).collect::<Vec<_>>(), [10, 10, 10, 10, 2, 2, 2, 2]);
+
+    // A refinement beyond the model's budget: the user's cap (--max-elements) decides, not the
+    // model's budget, which guards only the model's own field.
+    let fine = ["--refine-face", "1,0.006"];
+    let output = mesh_square(&fine);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let elements = amber_mesh::read_mesh::<2>(&final_mesh).unwrap().num_elements();
+    let output = mesh_square(&[&fine[..], &["--max-elements", &(elements / 2).to_string()]].concat());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("--max-elements"), "{elements} elements: {stderr}");
     for (refine, expected) in [("99,0.02", "its faces are 1–8"), ("1", "FACE,SIZE"), ("1,-0.5", "positive")] {
         let output = mesh_square(&["--refine-face", refine]);
         let stderr = String::from_utf8_lossy(&output.stderr);

@@ -265,7 +265,8 @@ const BUDGET_TARGET: f64 = 0.95;
 /// One generation step from `mesh` with the predicted per-element `sizes`: clip below at h_min,
 /// check the element budget (skip, or scale to it, as `limits` says), hold the field within a
 /// user's `bounds` (after the budget, which guards the model's field: a refinement box adds its
-/// elements rather than coarsening the rest), mesh.
+/// elements rather than coarsening the rest), mesh (up to the bounds' cap on elements when the
+/// user set one, else [`MeshLimits::generator_cap`]).
 pub fn generation_step<const D: usize, P: Domain<D> + ?Sized>(
     problem: &P,
     mesh: &Mesh<D>,
@@ -286,7 +287,7 @@ pub fn generation_step<const D: usize, P: Domain<D> + ?Sized>(
         sizes.iter_mut().for_each(|h| *h *= factor);
     }
     bounds.apply(problem, mesh, &mut sizes);
-    let cap = limits.generator_cap();
+    let cap = bounds.max_elements().unwrap_or_else(|| limits.generator_cap());
     match problem.remesh(mesh, sizes, cap) {
         Ok(mesh) => StepOutcome::Meshed(mesh),
         Err(ProblemError::Meshing(MeshgenError::TooManyElements { cap })) => {
@@ -308,13 +309,15 @@ const ELEMENT_COUNT_ATTEMPTS: usize = 5;
 /// contact or a result plot wants no element above a size), and boxes and boundary faces where
 /// elements are to be no larger than a size (a bolt hole, a weld, a contact face: where the
 /// stresses matter). They act after every other scaling, so the model still decides where
-/// elements go within them.
+/// elements go within them. What they add is the user's call, so the user caps the mesh they make
+/// (`--max-elements`), not the model's budget, which guards only the model's own field.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SizeBounds {
     min: f64,
     max: f64,
     boxes: Vec<RefineBox>,
     faces: Vec<RefineFace>,
+    max_elements: Option<usize>,
 }
 
 /// An axis-aligned box (corners `lo`, `hi` in the geometry's `lo.len()` dimensions) where the
@@ -338,7 +341,7 @@ pub struct RefineFace {
 impl Default for SizeBounds {
     /// No bounds.
     fn default() -> Self {
-        Self { min: 0.0, max: f64::INFINITY, boxes: Vec::new(), faces: Vec::new() }
+        Self { min: 0.0, max: f64::INFINITY, boxes: Vec::new(), faces: Vec::new(), max_elements: None }
     }
 }
 
@@ -391,6 +394,17 @@ impl SizeBounds {
             return Err(format!("the {what}'s size {max_size} is below the minimum size {}", self.min));
         }
         Ok(())
+    }
+
+    /// These bounds with the generator refusing to build more than `max_elements` elements under
+    /// them (instead of the model's [`MeshLimits::generator_cap`]).
+    pub fn with_max_elements(self, max_elements: usize) -> Self {
+        Self { max_elements: Some(max_elements), ..self }
+    }
+
+    /// The user's cap on the elements of a mesh under these bounds, if one was set.
+    pub fn max_elements(&self) -> Option<usize> {
+        self.max_elements
     }
 
     /// The refinement boxes.

@@ -38,6 +38,10 @@ pub enum TrainError {
     /// generator failed); `step` counts from 1.
     #[error("generation step {step}: {reason}")]
     Generation { step: usize, reason: String },
+    /// The last step of [`crate::generate`], within the user's size bounds, would have more
+    /// elements than the bounds' cap.
+    #[error("generation step {step}: the field within the size bounds asks for more than the cap of {cap} elements")]
+    OverCap { step: usize, cap: usize },
     /// A model file holds values no model can have (non-finite or negative moments, limits that
     /// are not positive) or that do not fit its network; the message names the field.
     #[error("{path}: {message}")]

@@ -5,6 +5,7 @@
 //! domain without an expert: what `amber mesh --model` runs.
 
 use amber_mesh::Mesh;
+use amber_meshgen::MeshgenError;
 use amber_metrics::{compare_meshes, normalised_dcd};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -221,23 +222,14 @@ pub struct GeneratedStep<const D: usize> {
     pub mesh: Mesh<D>,
 }
 
-/// What a user asks of the last step of [`generate`]: an element count, and a range and
-/// refinement boxes for its sizes. The default asks nothing: the model's own final step scale
-/// decides.
+/// What a user asks of the last step of [`generate`]: an element count (reached within
+/// `amber_tasks::ELEMENT_COUNT_TOLERANCE` when the generator allows), and a range, refinement
+/// boxes and faces for its sizes with a cap on its elements. The default asks nothing: the model's
+/// own final step scale and budget decide.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FinalStep {
-    pub target: Option<ElementTarget>,
+    pub elements: Option<usize>,
     pub bounds: SizeBounds,
-}
-
-/// An element count to aim the last step of [`generate`] at.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ElementTarget {
-    /// Elements wanted (reached within `amber_tasks::ELEMENT_COUNT_TOLERANCE` when the
-    /// generator allows).
-    pub elements: usize,
-    /// The generator refuses to build more than this.
-    pub max_elements: usize,
 }
 
 /// Meshes `domain` with `model` for `steps` generation steps from its M⁰ (predict, clip at
@@ -259,20 +251,26 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     for step in 1..=steps {
         let current = out.last().map_or(domain.initial_mesh(), |s| &s.mesh);
         let mut field = model.predict(&[domain], &[current])?.pop().expect("one field per domain");
-        if step == steps && last.target.is_none() {
+        if step == steps && last.elements.is_none() {
             field.scale(model.limits().final_step_scale);
         }
         let on = field.mesh.as_ref().unwrap_or(current);
-        let mesh = match last.target.filter(|_| step == steps) {
-            Some(target) => {
+        let mesh = match last.elements.filter(|_| step == steps) {
+            Some(elements) => {
                 let min_size = model.limits().min_size;
                 let sizes: Vec<f64> = field.sizes.iter().map(|h| h.max(min_size)).collect();
-                mesh_to_element_count(domain, on, &sizes, target.elements, &last.bounds, target.max_elements)
-                    .map_err(|e| TrainError::Generation { step, reason: e.to_string() })?
+                let cap = last.bounds.max_elements().unwrap_or_else(|| model.limits().generator_cap());
+                mesh_to_element_count(domain, on, &sizes, elements, &last.bounds, cap).map_err(|e| match e {
+                    ProblemError::Meshing(MeshgenError::TooManyElements { cap }) => TrainError::OverCap { step, cap },
+                    e => TrainError::Generation { step, reason: e.to_string() },
+                })?
             }
             None => match generation_step(domain, on, field.sizes.clone(), model.limits(), bounds_at(step)) {
                 StepOutcome::Meshed(mesh) => mesh,
                 StepOutcome::OverBudget { estimated_elements } => {
+                    if let Some(cap) = bounds_at(step).max_elements() {
+                        return Err(TrainError::OverCap { step, cap });
+                    }
                     let reason = format!(
                         "the predicted field asks for about {estimated_elements:.0} elements, over the model's budget of {}",
                         model.limits().max_elements
