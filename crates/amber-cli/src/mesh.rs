@@ -58,17 +58,17 @@ pub struct MeshArgs {
     /// Hold the final step's sizing field at or above this size (in the geometry's units), e.g.
     /// for an explicit solver's time step. The field bounds the elements as it sizes them: they
     /// scatter around it, and are smaller where the geometry's curvature or thin walls ask.
-    #[arg(long, requires = "model")]
+    #[arg(long)]
     min_size: Option<f64>,
     /// Hold the final step's sizing field at or below this size.
-    #[arg(long, requires = "model")]
+    #[arg(long)]
     max_size: Option<f64>,
     /// A box where the final mesh's elements are to be no larger than SIZE (a bolt hole, a weld,
     /// where the stresses matter): `X0,Y0,X1,Y1,SIZE` in 2D, `X0,Y0,Z0,X1,Y1,Z1,SIZE` in 3D, the
     /// box's lower and upper corners. The last step's field is held at SIZE on every element of
     /// the mesh before it that meets the box (so the refinement may reach one such element
     /// beyond it); --elements counts the box's elements in. May be given more than once.
-    #[arg(long, requires = "model", value_parser = parse_refine_box, value_name = "CORNERS,SIZE", allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_refine_box, value_name = "CORNERS,SIZE", allow_hyphen_values = true)]
     refine_box: Vec<RefineBox>,
     /// A piece of the boundary where the final mesh's elements are to be no larger than SIZE (a
     /// contact face, a hole's wall, a loaded edge): `FACE,SIZE`, FACE the number of a CAD face of
@@ -76,7 +76,7 @@ pub struct MeshArgs {
     /// last step's field is held at SIZE on every element of the mesh before it with a vertex on
     /// the face, a layer as deep as that mesh's elements there; --elements counts them in. May
     /// be given more than once.
-    #[arg(long, requires = "model", value_parser = parse_refine_face, value_name = "FACE,SIZE")]
+    #[arg(long, value_parser = parse_refine_face, value_name = "FACE,SIZE")]
     refine_face: Vec<RefineFace>,
     /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,
     /// and its domain when no geometry is given; its expert mesh, when present, is the default
@@ -107,7 +107,7 @@ pub struct MeshArgs {
     /// Print the pieces of the geometry's boundary that --refine-face and the written mesh's
     /// `boundary_<FACE>` groups number (CAD faces of a solid, sides of a polygon), each with its
     /// area (length in 2D), centre and bounding box, as the model meshes the geometry; mesh nothing.
-    #[arg(long, requires = "model")]
+    #[arg(long)]
     list_faces: bool,
     /// Element order of the output: 1, or 2 for 10-node tetrahedra and 6-node triangles (edge
     /// nodes at the edges' midpoints; .msh, .vtu, .vtk, .nas, .inp).
@@ -128,7 +128,26 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     }
     match &args.model {
         Some(model) => with_model(&args, model),
-        None => with_size(&args, args.size.as_deref().expect("clap requires --size without --model")),
+        None => {
+            // clap's `requires` yields to `conflicts_with` between --model and --size, so the
+            // flags that act on a model's rollout are checked here.
+            let model_only = [
+                ("--steps", args.steps.is_some()),
+                ("--elements", args.elements.is_some()),
+                ("--min-size", args.min_size.is_some()),
+                ("--max-size", args.max_size.is_some()),
+                ("--refine-box", !args.refine_box.is_empty()),
+                ("--refine-face", !args.refine_face.is_empty()),
+                ("--list-faces", args.list_faces),
+                ("--problem", args.problem.is_some()),
+                ("--expert", args.expert.is_some()),
+                ("--every-step", args.every_step.is_some()),
+            ];
+            if let Some((flag, _)) = model_only.iter().find(|(_, given)| *given) {
+                bail!("{flag} needs --model: with --size the sizes are given, not predicted");
+            }
+            with_size(&args, args.size.as_deref().expect("clap requires --size without --model"))
+        }
     }
 }
 

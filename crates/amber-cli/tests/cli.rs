@@ -98,6 +98,18 @@ fn bad_input_fails_with_a_message_not_a_panic() {
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(stderr.to_lowercase().contains("error") && !stderr.contains("panicked"), "{args:?}: {stderr}");
     }
+    // A flag that acts on a model's rollout is refused with --size, not ignored.
+    for flag in [&["--refine-face", "1,0.01"][..], &["--min-size", "0.05"], &["--elements", "500"], &["--list-faces"]] {
+        let output = amber().args(["mesh", "lshape", "--size", "0.1"]).args(flag).arg("-o").arg(&out).output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && stderr.contains(&format!("{} needs --model", flag[0])),
+            "{flag:?}: {stderr}"
+        );
+    }
+    let output = amber().args(["mesh", "lshape", "--size", "0.1", "--list-faces"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && !stderr.contains("panicked"), "{stderr}");
 }
 
 #[test]
