@@ -407,16 +407,6 @@ impl SizeBounds {
         self.max_elements
     }
 
-    /// The refinement boxes.
-    pub fn boxes(&self) -> &[RefineBox] {
-        &self.boxes
-    }
-
-    /// The refined boundary faces.
-    pub fn faces(&self) -> &[RefineFace] {
-        &self.faces
-    }
-
     /// `h` moved into the range (the boxes aside).
     pub fn clamp(&self, h: f64) -> f64 {
         h.clamp(self.min, self.max)
