@@ -10,11 +10,12 @@ use amber_mesh::Mesh;
 use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{Tile, mesh_gallery};
 use amber_tasks::Problem;
-use amber_tasks::folder::{DatasetSettings, FolderDomain, Split, mesh_dimension, problems, read_experts};
+use amber_tasks::folder::{DatasetSettings, Expert, FolderDomain, Split, mesh_dimension, problems, read_experts};
 use amber_tasks::part::{PlanarPart, SolidPart};
 use amber_train::{Evaluation, EvaluationSummary, TrainedModel};
 use anyhow::{Context, bail};
 use clap::Args;
+use serde::Serialize;
 
 use crate::mesh::{Picture, shipped_models};
 
@@ -97,17 +98,46 @@ pub fn run(args: EvaluateArgs) -> anyhow::Result<()> {
     // As `amber mesh` does: a field over the budget is scaled to it, not skipped.
     model.limits_mut().scale_to_budget = true;
     let settings = DatasetSettings::read(split.parent().unwrap_or(Path::new(".")))?;
-    let evaluation = Run { args: &args, card: &card, model: &model, split: &split, settings: &settings, steps };
-    match card.task {
-        Task::Console | Task::Folder { dimension: 3 } => evaluation.parts::<3, SolidPart>(),
-        Task::Folder { dimension: 2 } => evaluation.parts::<2, PlanarPart>(),
+    let scorer = PartScorer { model: &model, initial_size: card.initial_size, settings: &settings, steps };
+    let out = &args.out;
+    let (parts, summary) = match card.task {
+        Task::Console | Task::Folder { dimension: 3 } => {
+            scorer.score::<3, SolidPart>(read_experts(&split, None)?, None, out)?
+        }
+        Task::Folder { dimension: 2 } => scorer.score::<2, PlanarPart>(read_experts(&split, None)?, None, out)?,
         Task::Poisson => bail!(
             "{}: a Poisson model reads each problem's load; evaluate it with `cargo xtask reproduce poisson --test-set`",
             dir.display()
         ),
         Task::Folder { dimension } => bail!("{}: a model of {dimension}D meshes", dir.display()),
-    }
+    };
+    let json = serde_json::json!({
+        "model": args.model.model, "card": card, "data": split, "steps": steps, "summary": summary, "parts": parts,
+    });
+    write_json(&out.join("evaluation.json"), &json)?;
+    let mut md = format!(
+        "# Evaluation of {} on {}\n\n{} ({}), {steps} generation steps; {SCORES}\n\n",
+        args.model.model,
+        split.display(),
+        card.method,
+        card.data,
+    );
+    md.push_str(&score_table(&parts));
+    write_atomic(&out.join("evaluation.md"), md.as_bytes())?;
+    println!(
+        "{} parts of {}: mean normalised DCD {:.3} after {steps} steps; wrote {}",
+        parts.len(),
+        split.display(),
+        summary.final_normalised_dcd().unwrap_or(f64::NAN),
+        out.display()
+    );
+    Ok(())
 }
+
+/// What the columns of [`score_table`] mean, for the text above it.
+pub const SCORES: &str = "normalised DCD: 0 as good as the expert's own field re-meshed, 1 no better than M⁰. \
+    Sizes ÷ expert's: each final element's size over the expert's element at its midpoint, 10th percentile, \
+    median, 90th percentile (above 1: coarser than the expert).";
 
 /// A gallery tile of `mesh` coloured by element size.
 fn tile<const D: usize>(title: String, mesh: &Mesh<D>) -> Tile<'_>
@@ -117,115 +147,113 @@ where
     Tile { title, mesh: mesh.tile_mesh(), values: mesh.sizes() }
 }
 
-/// One evaluation's inputs.
-struct Run<'a> {
-    args: &'a EvaluateArgs,
-    card: &'a ModelCard,
-    model: &'a TrainedModel,
-    split: &'a Path,
-    settings: &'a DatasetSettings,
-    steps: usize,
+/// One part's scores, as `evaluation.json` lists them.
+#[derive(Serialize)]
+pub struct PartScore {
+    /// `split/stem`.
+    pub name: String,
+    /// The part's picture (generated beside expert), in the output directory.
+    pub picture: String,
+    pub evaluation: ProblemEvaluation,
+    pub size_ratios: SizeRatios,
+    /// The cross-validation fold that held the part out.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fold: Option<usize>,
 }
 
-impl Run<'_> {
-    /// Loads the parts (M⁰ at the card's size), rolls the model out on each, writes the outputs.
-    fn parts<const D: usize, P: FolderDomain<D>>(&self) -> anyhow::Result<()>
+impl PartScore {
+    /// Final elements over the expert's.
+    pub fn element_ratio(&self) -> f64 {
+        self.evaluation.last().elements as f64 / self.evaluation.expert_elements as f64
+    }
+}
+
+/// A model's rollouts on parts of a folder, scored against their experts.
+pub struct PartScorer<'a> {
+    pub model: &'a TrainedModel,
+    /// Edge length of every part's M⁰ (the model card's).
+    pub initial_size: f64,
+    pub settings: &'a DatasetSettings,
+    pub steps: usize,
+}
+
+impl PartScorer<'_> {
+    /// Rolls the model out on `experts`' parts, writes a picture per part into `out` and returns
+    /// each part's scores (marked with `fold`) and their summary.
+    pub fn score<const D: usize, P: FolderDomain<D>>(
+        &self,
+        experts: Vec<Expert<D>>,
+        fold: Option<usize>,
+        out: &Path,
+    ) -> anyhow::Result<(Vec<PartScore>, EvaluationSummary)>
     where
         Mesh<D>: Picture,
     {
-        let experts = read_experts::<D>(self.split, None)?;
         let names: Vec<String> = experts.iter().map(|e| e.name.clone()).collect();
-        let parts = problems::<D, P>(experts, self.card.initial_size, self.settings)?;
+        let parts = problems::<D, P>(experts, self.initial_size, self.settings)?;
         let evaluation = Evaluation::new(&parts, self.model.limits())?;
         let rollouts = self.model.rollouts(&evaluation, self.steps)?;
-        let summary = EvaluationSummary::new(&parts, &rollouts);
-        let scores: Vec<ProblemEvaluation> =
-            rollouts.iter().zip(&parts).map(|(r, p)| ProblemEvaluation::of(r, p)).collect();
-        let out = &self.args.out;
         std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
-        let (mut pictures, mut size_ratios) = (Vec::new(), Vec::new());
-        for ((name, rollout), part) in names.iter().zip(&rollouts).zip(&parts) {
+        let mut scores = Vec::new();
+        for ((name, rollout), part) in names.into_iter().zip(&rollouts).zip(&parts) {
             let generated = &rollout.steps.last().context("no generation step")?.mesh;
             let expert = part.expert_mesh();
-            size_ratios.push(SizeRatios::of(&log_size_ratios(generated, expert)));
             let picture = format!("{}.png", name.replace(['/', '\\'], "-"));
             let row = vec![
                 tile(format!("{name}: generated, {} el.", generated.num_elements()), generated),
                 tile(format!("{name}: expert, {} el.", expert.num_elements()), expert),
             ];
             mesh_gallery(&out.join(&picture), &[row], (520, 440))?;
-            pictures.push(picture);
+            let size_ratios = SizeRatios::of(&log_size_ratios(generated, expert));
+            scores.push(PartScore {
+                name,
+                picture,
+                evaluation: ProblemEvaluation::of(rollout, part),
+                size_ratios,
+                fold,
+            });
         }
-        let json = serde_json::json!({
-            "model": self.args.model.model,
-            "card": self.card,
-            "data": self.split,
-            "steps": self.steps,
-            "summary": summary,
-            "parts": names.iter().zip(&scores).zip(&pictures).zip(&size_ratios).map(|(((name, score), picture), ratios)| {
-                serde_json::json!({ "name": name, "picture": picture, "evaluation": score, "size_ratios": ratios })
-            }).collect::<Vec<_>>(),
-        });
-        write_json(&out.join("evaluation.json"), &json)?;
-        write_atomic(&out.join("evaluation.md"), self.markdown(&names, &scores, &size_ratios, &summary).as_bytes())?;
-        println!(
-            "{} parts of {}: mean normalised DCD {:.3} after {} steps; wrote {}",
-            parts.len(),
-            self.split.display(),
-            summary.final_normalised_dcd().unwrap_or(f64::NAN),
-            self.steps,
-            out.display()
-        );
-        Ok(())
+        Ok((scores, EvaluationSummary::new(&parts, &rollouts)))
     }
+}
 
-    /// The per-part table with the means, as `evaluation.md` holds it.
-    fn markdown(
-        &self,
-        names: &[String],
-        scores: &[ProblemEvaluation],
-        size_ratios: &[SizeRatios],
-        summary: &EvaluationSummary,
-    ) -> String {
-        let mut md = format!(
-            "# Evaluation of {} on {}\n\n{} ({}), {} generation steps; normalised DCD: 0 as good as the expert's \
-             own field re-meshed, 1 no better than M⁰. Sizes ÷ expert's: each final element's size over the \
-             expert's element at its midpoint, 10th percentile, median, 90th percentile (above 1: coarser than \
-             the expert).\n\n",
-            self.args.model.model,
-            self.split.display(),
-            self.card.method,
-            self.card.data,
-            self.steps
+/// The per-part table of `parts` with their means (a fold column when they came from folds).
+pub fn score_table(parts: &[PartScore]) -> String {
+    let folds = parts.iter().any(|p| p.fold.is_some());
+    let fold_column = if folds { ["fold | ", "---:|"] } else { ["", ""] };
+    let mut md = format!(
+        "| part | {}normalised DCD | DCD | volume difference | elements | expert elements | sizes ÷ expert's |\n",
+        fold_column[0]
+    );
+    let _ = writeln!(md, "|---|{}---:|---:|---:|---:|---:|---:|", fold_column[1]);
+    for part in parts {
+        let (last, r) = (part.evaluation.last(), &part.size_ratios);
+        let fold = part.fold.map_or(String::new(), |f| format!("{f} | "));
+        let _ = writeln!(
+            md,
+            "| {} | {fold}{:.3} | {:.4} | {:.3e} | {} | {} | {:.2}, {:.2}, {:.2} |",
+            part.name,
+            last.normalised_dcd,
+            last.dcd,
+            last.volume_difference,
+            last.elements,
+            part.evaluation.expert_elements,
+            r.p10,
+            r.median,
+            r.p90
         );
-        md.push_str(
-            "| part | normalised DCD | DCD | volume difference | elements | expert elements | sizes ÷ expert's |\n",
-        );
-        md.push_str("|---|---:|---:|---:|---:|---:|---:|\n");
-        for ((name, score), r) in names.iter().zip(scores).zip(size_ratios) {
-            let last = score.last();
-            let _ = writeln!(
-                md,
-                "| {name} | {:.3} | {:.4} | {:.3e} | {} | {} | {:.2}, {:.2}, {:.2} |",
-                last.normalised_dcd,
-                last.dcd,
-                last.volume_difference,
-                last.elements,
-                score.expert_elements,
-                r.p10,
-                r.median,
-                r.p90
-            );
-        }
-        let n = scores.len().max(1) as f64;
-        let volume = scores.iter().map(|s| s.last().volume_difference).sum::<f64>() / n;
-        if let Some(step) = summary.steps.last() {
-            let _ = writeln!(
-                md,
-                "| **mean** | **{:.3}** | **{:.4}** | **{volume:.3e}** | **{:.0}** | **{:.0}** | |",
-                step.normalised_dcd, step.dcd, step.elements, summary.expert_elements
-            );
-        }
-        md
     }
+    let n = parts.len().max(1) as f64;
+    let mean = |f: &dyn Fn(&PartScore) -> f64| parts.iter().map(f).sum::<f64>() / n;
+    let _ = writeln!(
+        md,
+        "| **mean** | {}**{:.3}** | **{:.4}** | **{:.3e}** | **{:.0}** | **{:.0}** | |",
+        if folds { " | " } else { "" },
+        mean(&|p| p.evaluation.last().normalised_dcd),
+        mean(&|p| p.evaluation.last().dcd),
+        mean(&|p| p.evaluation.last().volume_difference),
+        mean(&|p| p.evaluation.last().elements as f64),
+        mean(&|p| p.evaluation.expert_elements as f64),
+    );
+    md
 }

@@ -8,6 +8,7 @@
 
 mod calibrate;
 mod convert;
+mod cross_validate;
 mod evaluate;
 mod mesh;
 mod train;
@@ -32,6 +33,9 @@ enum Command {
     Convert(convert::ConvertArgs),
     /// Score a model on a folder of expert meshes: evaluation.json, evaluation.md, a picture per part.
     Evaluate(evaluate::EvaluateArgs),
+    /// Estimate how a model of a folder's experts meshes unseen parts: train one model per fold of
+    /// the training parts, score each on the parts it held out, pool the scores.
+    CrossValidate(cross_validate::CrossValidateArgs),
     /// Fit a model's element budget to a folder of expert meshes; write it as a new model directory.
     Calibrate(calibrate::CalibrateArgs),
 }
@@ -51,5 +55,6 @@ fn main() -> anyhow::Result<()> {
         Command::Convert(args) => convert::run(args),
         Command::Evaluate(args) => evaluate::run(args),
         Command::Calibrate(args) => calibrate::run(args),
+        Command::CrossValidate(args) => cross_validate::run(args),
     }
 }

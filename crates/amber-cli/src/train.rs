@@ -2,14 +2,14 @@
 //! killed run there) and writes the model's card. The task is a dataset folder of expert meshes
 //! when `--data` holds a `train/` directory, else generated Poisson problems.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use amber_experiments::{Method, ModelCard, amber_config, commit, merge_json, train_folder, train_poisson};
 use amber_stdx::read_json;
 use amber_tasks::folder::{Split, mesh_dimension};
 use amber_tasks::poisson::{Difficulty, INITIAL_SIZE};
 use amber_train::{MODEL_DIR, MethodConfig, Profile};
-use anyhow::Context;
+use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 /// The learning tasks.
@@ -22,20 +22,15 @@ pub enum Task {
     Folder,
 }
 
+/// How to train, as `amber train` and `amber cross-validate` both take it.
 #[derive(Args)]
-pub struct TrainArgs {
-    /// The task (default: `folder` when --data holds a `train/` directory, else `poisson`).
-    #[arg(long, value_enum)]
-    task: Option<Task>,
+pub struct TrainingArgs {
     /// smoke (minutes), quick (about 30 minutes on 2 cores), paper (GPU scale).
     #[arg(long, default_value = "quick")]
     profile: Profile,
-    /// Expert refinement steps of the problems: easy (25), medium (50), hard (75).
-    #[arg(long, default_value = "hard")]
-    difficulty: Difficulty,
     /// amber-mean or amber-max.
     #[arg(long, default_value = "amber-mean")]
-    method: Method,
+    pub method: Method,
     /// Training seed: selects the training problems and seeds the run.
     #[arg(long, default_value_t = 0)]
     seed: usize,
@@ -45,6 +40,76 @@ pub struct TrainArgs {
     /// A JSON file of training-config fields overriding the profile's.
     #[arg(long)]
     config: Option<PathBuf>,
+}
+
+impl TrainingArgs {
+    /// The validated training config of `task`: the profile's, with the method, seed, config
+    /// file and steps given.
+    pub fn config(&self, task: amber_experiments::Task) -> anyhow::Result<MethodConfig> {
+        let mut config = amber_config(task, self.profile);
+        config.aggregation = self.method.aggregation();
+        config.seed = self.seed as u64;
+        if let Some(path) = &self.config {
+            let mut value = serde_json::to_value(&config)?;
+            merge_json(&mut value, &read_json(path)?);
+            config =
+                serde_json::from_value(value).with_context(|| format!("{}: not a training config", path.display()))?;
+        }
+        if let Some(steps) = self.steps {
+            config.steps = steps;
+        }
+        let config = MethodConfig::Amber(config);
+        config.validate().with_context(|| match &self.config {
+            Some(path) => format!("{}: with the {} profile", path.display(), self.profile),
+            None => format!("the {} profile", self.profile),
+        })?;
+        Ok(config)
+    }
+
+    /// Writes the card of the model trained with `config` into `model` (a run's model directory).
+    pub fn write_card(
+        &self,
+        model: &Path,
+        task: amber_experiments::Task,
+        config: &MethodConfig,
+        trained: Trained,
+    ) -> anyhow::Result<()> {
+        let MethodConfig::Amber(amber) = config else { bail!("amber trains AMBER models") };
+        let card = ModelCard {
+            task,
+            method: self.method.to_string(),
+            inference_steps: amber.inference_steps,
+            initial_size: trained.initial_size,
+            command: std::env::args().collect::<Vec<_>>().join(" "),
+            data: trained.data,
+            commit: commit().to_owned(),
+            training_seconds: trained.seconds,
+            evaluation: None,
+        };
+        card.write(model)
+    }
+}
+
+/// What a training made, for its model's card.
+pub struct Trained {
+    /// Training wall time, seconds.
+    pub seconds: f64,
+    /// Edge length of M⁰.
+    pub initial_size: f64,
+    /// The training data, in words.
+    pub data: String,
+}
+
+#[derive(Args)]
+pub struct TrainArgs {
+    /// The task (default: `folder` when --data holds a `train/` directory, else `poisson`).
+    #[arg(long, value_enum)]
+    task: Option<Task>,
+    #[command(flatten)]
+    training: TrainingArgs,
+    /// Expert refinement steps of the problems: easy (25), medium (50), hard (75).
+    #[arg(long, default_value = "hard")]
+    difficulty: Difficulty,
     /// A dataset folder of expert meshes (`train/`, `val/`), or the Poisson dataset root (problems
     /// are generated there when missing).
     #[arg(long, default_value = "data/poisson")]
@@ -70,56 +135,31 @@ pub fn train(args: TrainArgs) -> anyhow::Result<()> {
     };
     let card_task =
         dimension.map_or(amber_experiments::Task::Poisson, |dimension| amber_experiments::Task::Folder { dimension });
-    let mut config = amber_config(card_task, args.profile);
-    config.aggregation = args.method.aggregation();
-    config.seed = args.seed as u64;
-    if let Some(path) = &args.config {
-        let mut value = serde_json::to_value(&config)?;
-        merge_json(&mut value, &read_json(path)?);
-        config = serde_json::from_value(value).with_context(|| format!("{}: not a training config", path.display()))?;
-    }
-    if let Some(steps) = args.steps {
-        config.steps = steps;
-    }
-    let inference_steps = config.inference_steps;
-    let config = MethodConfig::Amber(config);
-    config.validate().with_context(|| match &args.config {
-        Some(path) => format!("{}: with the {} profile", path.display(), args.profile),
-        None => format!("the {} profile", args.profile),
-    })?;
-    let (seconds, initial_size, data) = match dimension {
+    let training = &args.training;
+    let config = training.config(card_task)?;
+    let trained = match dimension {
         None => {
-            let label = format!("{} {} seed {}", args.method, args.difficulty, args.seed);
+            let label = format!("{} {} seed {}", training.method, args.difficulty, training.seed);
             let seconds = train_poisson(&config, args.difficulty, &args.data, &args.manifest, &args.out, &label)?;
             let data = format!(
                 "{} problems of {}, difficulty {}, seed {}",
                 args.data.display(),
                 args.manifest.display(),
                 args.difficulty,
-                args.seed
+                training.seed
             );
-            (seconds, INITIAL_SIZE, data)
+            Trained { seconds, initial_size: INITIAL_SIZE, data }
         }
         Some(dimension) => {
-            let label = format!("{} {} seed {}", args.method, args.data.display(), args.seed);
-            let trained = train_folder(&config, dimension, &args.data, args.initial_size, &args.out, &label)?;
+            let label = format!("{} {} seed {}", training.method, args.data.display(), training.seed);
+            let trained = train_folder(&config, dimension, &args.data, args.initial_size, None, &args.out, &label)?;
             let data = format!("{} ({} training parts, {dimension}D)", args.data.display(), trained.parts);
-            (trained.seconds, trained.initial_size, data)
+            Trained { seconds: trained.seconds, initial_size: trained.initial_size, data }
         }
     };
+    let seconds = trained.seconds;
     let model = args.out.join(MODEL_DIR);
-    let card = ModelCard {
-        task: card_task,
-        method: args.method.to_string(),
-        inference_steps,
-        initial_size,
-        command: std::env::args().collect::<Vec<_>>().join(" "),
-        data,
-        commit: commit().to_owned(),
-        training_seconds: seconds,
-        evaluation: None,
-    };
-    card.write(&model)?;
+    training.write_card(&model, card_task, &config, trained)?;
     println!("trained in {seconds:.0} s; model in {}", model.display());
     Ok(())
 }

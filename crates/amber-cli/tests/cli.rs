@@ -461,6 +461,66 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     assert_eq!(evaluation["parts"].as_array().unwrap().len(), 2);
 }
 
+/// `amber cross-validate` on the demo plates: a model per fold, each scoring the plates it held
+/// out, pooled into one table that lists every training plate once with its fold. Run again, it
+/// reuses the fold models and writes the same scores; other folds into the same directory, or
+/// more folds than parts, are refused with the reason.
+#[test]
+fn cross_validates_a_folder_of_expert_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("plates");
+    amber_tasks::folder::write_demo_dataset(&data, 3).unwrap();
+    let config = dir.path().join("config.json");
+    std::fs::write(
+        &config,
+        r#"{"checkpoint_interval": 10, "validation_interval": 0, "inference_steps": 2,
+            "network": {"latent_dim": 8, "message_passing_steps": 2}}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("cv");
+    let cross_validate = |folds: &str| {
+        let mut command = amber();
+        command.args(["cross-validate", "--profile", "smoke", "--steps", "20", "--folds", folds, "--data"]);
+        command.arg(&data).arg("--config").arg(&config).arg("--out").arg(&out).output().unwrap()
+    };
+    let output = cross_validate("3");
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let json = std::fs::read_to_string(out.join("evaluation.json")).unwrap();
+    let evaluation: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let parts = evaluation["parts"].as_array().unwrap();
+    let names: Vec<&str> = parts.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["train/plate00", "train/plate01", "train/plate02"]);
+    let mut total = 0.0;
+    for (k, (part, fold)) in parts.iter().zip(evaluation["folds"].as_array().unwrap()).enumerate() {
+        // Three plates in three folds: fold k holds out plate k alone and scores it.
+        assert_eq!(part["fold"], k);
+        assert_eq!(fold["held_out"], serde_json::json!([names[k]]));
+        let score = part["evaluation"]["steps"].as_array().unwrap().last().unwrap()["metrics"]["normalised_dcd"]
+            .as_f64()
+            .unwrap();
+        assert_eq!(fold["normalised_dcd"].as_f64().unwrap(), score);
+        total += score;
+        assert!(std::fs::metadata(out.join(part["picture"].as_str().unwrap())).unwrap().len() > 1000);
+        let card = std::fs::read_to_string(out.join(format!("fold{k}/model/card.json"))).unwrap();
+        assert!(card.contains(&format!("fold {k} of 3 holds out {}", names[k])), "{card}");
+    }
+    assert!((evaluation["normalised_dcd"].as_f64().unwrap() - total / 3.0).abs() < 1e-12);
+    let table = std::fs::read_to_string(out.join("evaluation.md")).unwrap();
+    assert!(table.contains("| train/plate01 | 1 | ") && table.contains("| **all** | 3 parts |"), "{table}");
+    println!("{table}");
+
+    let output = cross_validate("3");
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert_eq!(std::fs::read_to_string(out.join("evaluation.json")).unwrap(), json, "the same models, the same scores");
+
+    let output = cross_validate("2");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("held_out.json") && stderr.contains("new --out"), "{stderr}");
+    let output = cross_validate("4");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("takes 2 to 3 folds"), "{stderr}");
+}
+
 /// Parts' own inputs (`<stem>.inputs.json`) train into a model that names them; meshing a new part
 /// with that model needs them (`--problem`), and without them the error says so.
 #[test]

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use amber_mesh::Mesh3;
 use amber_plot::{Tile, TileMesh, View, mesh_gallery};
 use amber_tasks::console::{INITIAL_MESH_RECIPE, INITIAL_SIZE, TrainSet, check_data, has_test_split};
-use amber_tasks::folder::{DatasetSettings, Split, problems, read_experts};
+use amber_tasks::folder::{DatasetSettings, Fold, Split, problems, read_experts};
 use amber_tasks::part::SolidPart;
 use amber_tasks::{Problem, WithExpert};
 use amber_train::{MethodConfig, Profile};
@@ -171,12 +171,11 @@ impl ConsoleExperiment {
             Some(folds) => {
                 let all = self.load(Split::Train, usize::MAX, |_| true)?;
                 let parts = all.len();
-                if folds < 2 || folds > parts {
-                    bail!("{folds} folds: a cross-validation over {parts} training parts takes 2 to {parts} folds");
-                }
+                let fold_list = Fold::all(folds, parts).map_err(anyhow::Error::msg)?;
                 let mut tests: Vec<Vec<Part>> = (0..folds).map(|_| Vec::new()).collect();
                 for (i, part) in all.into_iter().enumerate() {
-                    tests[i % folds].push(part);
+                    let fold = fold_list.iter().position(|f| f.holds_out(i)).expect("every part is in one fold");
+                    tests[fold].push(part);
                 }
                 let names = (0..folds)
                     .map(|f| format!("console {folds}-fold cross-validation, fold {f} ({} parts)", tests[f].len()))
@@ -238,7 +237,7 @@ impl ConsoleExperiment {
 
     /// The first `count` training parts that fold `fold` trains on: all but those it holds out.
     fn training_parts(&self, fold: usize, count: usize) -> anyhow::Result<Vec<Part>> {
-        self.load(Split::Train, count, |i| self.folds.is_none_or(|folds| i % folds != fold))
+        self.load(Split::Train, count, |i| self.folds.is_none_or(|count| !Fold { index: fold, count }.holds_out(i)))
     }
 
     /// The parts of a split (of the training split, only the train set's) whose index in name

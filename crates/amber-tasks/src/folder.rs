@@ -76,6 +76,41 @@ impl Split {
     }
 }
 
+/// Fold `index` of a `count`-fold cross-validation over a split's parts in name order: part i
+/// is held out by fold i mod `count`, so that the held-out parts of a fold spread over the split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fold {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl Fold {
+    /// The `count` folds over `parts` parts, or why there are none: every fold must hold out a
+    /// part and train on another.
+    pub fn all(count: usize, parts: usize) -> Result<Vec<Fold>, String> {
+        if count < 2 || count > parts {
+            return Err(format!(
+                "{count} folds: a cross-validation over {parts} training parts takes 2 to {parts} folds"
+            ));
+        }
+        Ok((0..count).map(|index| Fold { index, count }).collect())
+    }
+
+    /// Whether this fold holds out the part at `index` in name order (and does not train on it).
+    pub fn holds_out(self, index: usize) -> bool {
+        index % self.count == self.index
+    }
+
+    /// The parts of a split in name order, parted into those this fold trains on and those it
+    /// holds out.
+    pub fn split<T>(self, parts: Vec<T>) -> (Vec<T>, Vec<T>) {
+        let (held_out, trained): (Vec<_>, Vec<_>) =
+            parts.into_iter().enumerate().partition(|(i, _)| self.holds_out(*i));
+        let strip = |parts: Vec<(usize, T)>| parts.into_iter().map(|(_, part)| part).collect();
+        (strip(trained), strip(held_out))
+    }
+}
+
 /// What `dataset.json` may set; every field is optional.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -433,6 +468,23 @@ mod tests {
     use super::*;
     use crate::part::GEOMETRY_INPUTS;
     use crate::problem::Problem;
+
+    #[test]
+    fn folds_part_a_split_into_held_out_parts_spread_over_it() {
+        let folds = Fold::all(3, 7).unwrap();
+        let mut held_out = Vec::new();
+        for fold in &folds {
+            let (trained, held) = fold.split((0..7).collect::<Vec<usize>>());
+            assert_eq!(trained.len() + held.len(), 7);
+            assert!(held.iter().all(|i| i % 3 == fold.index) && trained.iter().all(|i| !held.contains(i)));
+            held_out.extend(held);
+        }
+        held_out.sort();
+        assert_eq!(held_out, (0..7).collect::<Vec<_>>(), "every part is held out by exactly one fold");
+        for (count, parts) in [(1, 7), (8, 7), (2, 1)] {
+            assert!(Fold::all(count, parts).unwrap_err().contains(&format!("takes 2 to {parts} folds")));
+        }
+    }
 
     fn temp_dir(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("amber-folder-{name}-{}", std::process::id()));
