@@ -287,8 +287,7 @@ pub fn generation_step<const D: usize, P: Domain<D> + ?Sized>(
         sizes.iter_mut().for_each(|h| *h *= factor);
     }
     bounds.apply(problem, mesh, &mut sizes);
-    let cap = bounds.max_elements().unwrap_or_else(|| limits.generator_cap());
-    match problem.remesh(mesh, sizes, cap) {
+    match problem.remesh(mesh, sizes, bounds.element_cap(limits)) {
         Ok(mesh) => StepOutcome::Meshed(mesh),
         Err(ProblemError::Meshing(MeshgenError::TooManyElements { cap })) => {
             StepOutcome::OverBudget { estimated_elements: cap as f64 }
@@ -405,6 +404,12 @@ impl SizeBounds {
     /// The user's cap on the elements of a mesh under these bounds, if one was set.
     pub fn max_elements(&self) -> Option<usize> {
         self.max_elements
+    }
+
+    /// The cap on the elements of a mesh under these bounds: the user's, else the generator's
+    /// own safety net of `limits`.
+    pub fn element_cap(&self, limits: &MeshLimits) -> usize {
+        self.max_elements.unwrap_or_else(|| limits.generator_cap())
     }
 
     /// `h` moved into the range (the boxes aside).

@@ -259,7 +259,7 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
             Some(elements) => {
                 let min_size = model.limits().min_size;
                 let sizes: Vec<f64> = field.sizes.iter().map(|h| h.max(min_size)).collect();
-                let cap = last.bounds.max_elements().unwrap_or_else(|| model.limits().generator_cap());
+                let cap = last.bounds.element_cap(model.limits());
                 mesh_to_element_count(domain, on, &sizes, elements, &last.bounds, cap).map_err(|e| match e {
                     ProblemError::Meshing(MeshgenError::TooManyElements { cap }) => TrainError::OverCap { step, cap },
                     e => TrainError::Generation { step, reason: e.to_string() },
