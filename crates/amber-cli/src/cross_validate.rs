@@ -27,7 +27,8 @@ const HELD_OUT_FILE: &str = "held_out.json";
 #[derive(Args)]
 pub struct CrossValidateArgs {
     /// A dataset folder of expert meshes: its `train/` parts are parted into the folds (part i,
-    /// in name order, into fold i mod FOLDS), its `val/` parts validate every fold's training.
+    /// in name order, into fold i mod FOLDS), its `val/` parts, if any, validate every fold's
+    /// training.
     #[arg(long)]
     data: PathBuf,
     /// Folds: each trains a model on the training parts it does not hold out (2 up to the number
@@ -62,7 +63,14 @@ struct FoldScore {
 
 pub fn run(args: CrossValidateArgs) -> anyhow::Result<()> {
     let dimension = mesh_dimension(&Split::Train.dir(&args.data))?;
-    let config = args.training.config(Task::Folder { dimension })?;
+    let mut config = args.training.config(Task::Folder { dimension })?;
+    // The held-out parts are the test; a folder of a few parts need not spare some to validate.
+    if !Split::Val.dir(&args.data).is_dir()
+        && let MethodConfig::Amber(amber) = &mut config
+    {
+        amber.data.val_problems = 0;
+        println!("{}: no val/, so the folds train without validation", args.data.display());
+    }
     match dimension {
         2 => cross_validate::<2, PlanarPart>(&args, &config),
         3 => cross_validate::<3, SolidPart>(&args, &config),

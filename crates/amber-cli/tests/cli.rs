@@ -519,6 +519,16 @@ fn cross_validates_a_folder_of_expert_meshes() {
     let output = cross_validate("4");
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success() && stderr.contains("takes 2 to 3 folds"), "{stderr}");
+
+    // A folder of training parts alone cross-validates without validation.
+    std::fs::remove_dir_all(&out).unwrap();
+    std::fs::remove_dir_all(data.join("val")).unwrap();
+    let output = cross_validate("2");
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(String::from_utf8_lossy(&output.stdout).contains("without validation"));
+    let evaluation: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("evaluation.json")).unwrap()).unwrap();
+    assert_eq!(evaluation["folds"][0]["held_out"], serde_json::json!(["train/plate00", "train/plate02"]));
 }
 
 /// Parts' own inputs (`<stem>.inputs.json`) train into a model that names them; meshing a new part
