@@ -334,6 +334,17 @@ fn evaluate(model: &std::path::Path, data: &std::path::Path, out: &std::path::Pa
     serde_json::from_str(&std::fs::read_to_string(out.join("evaluation.json")).unwrap()).unwrap()
 }
 
+/// `dir/config.json`: a tiny network (width 8, two message-passing steps, two generation steps)
+/// checkpointed every 10 steps, with the config members `fields` besides.
+fn tiny_model_config(dir: &std::path::Path, fields: &str) -> std::path::PathBuf {
+    let config = dir.join("config.json");
+    let json = format!(
+        r#"{{"checkpoint_interval": 10, "inference_steps": 2, "network": {{"latent_dim": 8, "message_passing_steps": 2}}, {fields}}}"#
+    );
+    std::fs::write(&config, json).unwrap();
+    config
+}
+
 /// `amber train --profile smoke --steps STEPS --data DATA --config CONFIG --out RUN`.
 fn train_smoke_folder(
     data: &std::path::Path,
@@ -354,13 +365,7 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("plates");
     amber_tasks::folder::write_demo_dataset(&data, 1).unwrap();
-    let config = dir.path().join("config.json");
-    std::fs::write(
-        &config,
-        r#"{"checkpoint_interval": 10, "validation_interval": 10, "inference_steps": 2,
-            "network": {"latent_dim": 8, "message_passing_steps": 2}}"#,
-    )
-    .unwrap();
+    let config = tiny_model_config(dir.path(), r#""validation_interval": 10"#);
     let run = dir.path().join("run");
     let output = train_smoke_folder(&data, &config, &run, 30);
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
@@ -470,13 +475,7 @@ fn cross_validates_a_folder_of_expert_meshes() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("plates");
     amber_tasks::folder::write_demo_dataset(&data, 3).unwrap();
-    let config = dir.path().join("config.json");
-    std::fs::write(
-        &config,
-        r#"{"checkpoint_interval": 10, "validation_interval": 0, "inference_steps": 2,
-            "network": {"latent_dim": 8, "message_passing_steps": 2}}"#,
-    )
-    .unwrap();
+    let config = tiny_model_config(dir.path(), r#""validation_interval": 0"#);
     let out = dir.path().join("cv");
     let cross_validate = |folds: &str| {
         let mut command = amber();
@@ -546,14 +545,10 @@ fn a_model_of_parts_with_inputs_meshes_a_part_given_its_inputs() {
             std::fs::write(data.join(split).join(format!("{stem}.inputs.json")), inputs).unwrap();
         }
     }
-    let config = dir.path().join("config.json");
-    std::fs::write(
-        &config,
-        r#"{"checkpoint_interval": 10, "validation_interval": 0, "inference_steps": 2,
-            "network": {"latent_dim": 8, "message_passing_steps": 2},
-            "inputs": ["log_size", "log_boundary_distance", "load", "log_distance_to_clamp"]}"#,
-    )
-    .unwrap();
+    let config = tiny_model_config(
+        dir.path(),
+        r#""validation_interval": 0, "inputs": ["log_size", "log_boundary_distance", "load", "log_distance_to_clamp"]"#,
+    );
     let run = dir.path().join("run");
     let output = train_smoke_folder(&data, &config, &run, 10);
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
