@@ -25,7 +25,8 @@ pub enum Task {
 /// How to train, as `amber train` and `amber cross-validate` both take it.
 #[derive(Args)]
 pub struct TrainingArgs {
-    /// smoke (minutes), quick (about 30 minutes on 2 cores), paper (GPU scale).
+    /// smoke (minutes), quick (on 2 cores: 21–26 minutes of training on Poisson, 44–51 on the
+    /// Console parts, results/), paper (GPU scale).
     #[arg(long, default_value = "quick")]
     profile: Profile,
     /// amber-mean or amber-max: how the expert's sizes become labels on a coarser mesh. Max,
