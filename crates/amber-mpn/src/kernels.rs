@@ -4,7 +4,11 @@
 //! Everything is generic over f32 (training, inference) and f64 (gradient checks). Callers
 //! parallelise over blocks of rows, so every matmul here runs on one thread.
 
+use std::mem::MaybeUninit;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use candle_core::WithDType;
+use rayon::prelude::*;
 
 /// Rows per parallel work item: large enough for efficient matmuls, small enough that a block's
 /// temporaries stay in L2.
@@ -47,6 +51,48 @@ impl Real for f64 {
 
     fn tanh(self) -> Self {
         f64::tanh(self)
+    }
+}
+
+/// A zero-filled buffer for a parallel loop over its chunks. Each chunk is zeroed by the thread
+/// that takes it, in cache, right before the loop's kernel writes it: `vec![0; n]` zeroes the
+/// whole buffer first, on one thread, in a separate pass over memory (`memset` is a tenth of a
+/// Console training step, docs/PROFILES.md).
+pub(crate) struct ZeroedByChunk<T> {
+    values: Vec<T>,
+    len: usize,
+    handed_out: bool,
+    zeroed: AtomicUsize,
+}
+
+impl<T: Real> ZeroedByChunk<T> {
+    pub(crate) fn new(len: usize) -> Self {
+        Self { values: Vec::with_capacity(len), len, handed_out: false, zeroed: AtomicUsize::new(0) }
+    }
+
+    /// The buffer as zero-filled chunks of `chunk` values (the last may be shorter), in order.
+    /// Hands them out once.
+    pub(crate) fn par_chunks_mut(&mut self, chunk: usize) -> impl IndexedParallelIterator<Item = &mut [T]> {
+        assert!(!self.handed_out, "the chunks of a buffer are handed out once");
+        self.handed_out = true;
+        let (zeroed, zero) = (&self.zeroed, T::from_f64(0.0));
+        self.values.spare_capacity_mut()[..self.len].par_chunks_mut(chunk).map(move |values| {
+            values.iter_mut().for_each(|v| {
+                v.write(zero);
+            });
+            zeroed.fetch_add(values.len(), Ordering::Relaxed);
+            // SAFETY: every element of `values` was just written.
+            unsafe { &mut *(values as *mut [MaybeUninit<T>] as *mut [T]) }
+        })
+    }
+
+    /// The buffer as the loop left it. Panics unless the loop took every chunk.
+    pub(crate) fn into_vec(mut self) -> Vec<T> {
+        assert_eq!(*self.zeroed.get_mut(), self.len, "a parallel loop left chunks of its buffer unwritten");
+        // SAFETY: the chunks, handed out once, do not overlap, and each was zeroed before use;
+        // together they hold `len` values, so all of them are initialised.
+        unsafe { self.values.set_len(self.len) };
+        self.values
     }
 }
 
@@ -434,4 +480,28 @@ fn segment_sum(out: &mut [T], rows: &[T], offsets: &[u32], ids: Option<&[u32]>, 
         }
     }
 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_buffer_zeroed_by_chunk_holds_what_its_loop_wrote() {
+        let mut buffer = ZeroedByChunk::<f32>::new(10);
+        buffer.par_chunks_mut(4).enumerate().for_each(|(c, chunk)| {
+            assert!(chunk.iter().all(|&v| v == 0.0), "handed out zeroed");
+            chunk[0] = c as f32 + 1.0;
+        });
+        assert_eq!(buffer.into_vec(), [1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.0, 0.0]);
+        assert!(ZeroedByChunk::<f32>::new(0).into_vec().is_empty());
+    }
+
+    #[test]
+    #[should_panic(expected = "left chunks of its buffer unwritten")]
+    fn a_buffer_whose_loop_skipped_chunks_is_refused() {
+        let mut buffer = ZeroedByChunk::<f32>::new(10);
+        buffer.par_chunks_mut(4).take(2).for_each(|chunk| chunk[0] = 1.0);
+        buffer.into_vec();
+    }
 }

@@ -15,8 +15,8 @@ use rayon::prelude::*;
 use super::{Saved, SavedSlot, Scratch};
 use crate::graph::Topology;
 use crate::kernels::{
-    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, add_assign, add_gathered, matmul, packed_len, segment_sum,
-    tail_backward, tail_forward,
+    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, ZeroedByChunk, add_assign, add_gathered, matmul, packed_len,
+    segment_sum, tail_backward, tail_forward,
 };
 
 /// New edge states (E×D) from node states `x` (N×D), edge states `e` (E×D) and the packed edge
@@ -57,8 +57,7 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
         let d = self.d;
         let (n, m) = (self.topology.num_nodes(), self.topology.num_edges());
         let w = MlpWeights::unpack(theta, 3 * d, d);
-        let zero = T::from_f64(0.0);
-        let (mut p, mut q) = (vec![zero; n * d], vec![zero; n * d]);
+        let (mut p, mut q) = (ZeroedByChunk::new(n * d), ZeroedByChunk::new(n * d));
         (p.par_chunks_mut(BLOCK_ROWS * d), q.par_chunks_mut(BLOCK_ROWS * d), x.par_chunks(BLOCK_ROWS * d))
             .into_par_iter()
             .for_each(|(p, q, x)| {
@@ -66,6 +65,7 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
                 matmul(rows, d, d, x, false, w.w1_rows(0..d), false, p, false);
                 matmul(rows, d, d, x, false, w.w1_rows(d..2 * d), false, q, false);
             });
+        let (p, q) = (p.into_vec(), q.into_vec());
         let block = |b: usize, e: &[T], st: TailState<'_, T>, out: &mut [T]| {
             let rows = e.len() / d;
             matmul(rows, d, d, e, false, w.w1_rows(2 * d..3 * d), false, st.h1, false);
@@ -73,11 +73,11 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
             add_gathered(st.h1, &p, &q, &self.topology.src()[edges.clone()], &self.topology.dst()[edges], d);
             tail_forward(&w, e, st, out);
         };
-        let mut out = vec![zero; m * d];
+        let mut out = ZeroedByChunk::new(m * d);
         let chunk = BLOCK_ROWS * d;
         if self.save {
             let (mut h1, mut h2, mut mean, mut rstd) =
-                (vec![zero; m * d], vec![zero; m * d], vec![zero; m], vec![zero; m]);
+                (ZeroedByChunk::new(m * d), ZeroedByChunk::new(m * d), ZeroedByChunk::new(m), ZeroedByChunk::new(m));
             (
                 out.par_chunks_mut(chunk),
                 e.par_chunks(chunk),
@@ -90,10 +90,10 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
                 .enumerate()
                 .for_each(|(b, (out, e, h1, h2, mean, rstd))| block(b, e, TailState { h1, h2, mean, rstd }, out));
             self.saved.put(Saved {
-                h1: T::to_cpu_storage_owned(h1),
-                h2: T::to_cpu_storage_owned(h2),
-                mean: T::to_cpu_storage_owned(mean),
-                rstd: T::to_cpu_storage_owned(rstd),
+                h1: T::to_cpu_storage_owned(h1.into_vec()),
+                h2: T::to_cpu_storage_owned(h2.into_vec()),
+                mean: T::to_cpu_storage_owned(mean.into_vec()),
+                rstd: T::to_cpu_storage_owned(rstd.into_vec()),
             })?;
         } else {
             (out.par_chunks_mut(chunk), e.par_chunks(chunk)).into_par_iter().enumerate().for_each_init(
@@ -101,7 +101,7 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
                 |scratch, (b, (out, e))| block(b, e, scratch.state(e.len() / d, d), out),
             );
         }
-        Ok((out, Shape::from((m, d))))
+        Ok((out.into_vec(), Shape::from((m, d))))
     }
 
     fn backward(
@@ -149,13 +149,14 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
         );
 
         // Gradients of the gathered node products: segment sums by source and by destination.
-        let (mut dp, mut dq) = (vec![zero; n * d], vec![zero; n * d]);
+        let (mut dp, mut dq) = (ZeroedByChunk::new(n * d), ZeroedByChunk::new(n * d));
         let topo = &self.topology;
         (dp.par_chunks_mut(chunk), dq.par_chunks_mut(chunk)).into_par_iter().enumerate().for_each(|(b, (dp, dq))| {
             segment_sum(dp, &dpre1, topo.src_offsets(), Some(topo.by_src()), b * BLOCK_ROWS, d);
             segment_sum(dq, &dpre1, topo.dst_offsets(), None, b * BLOCK_ROWS, d);
         });
-        let mut dx = vec![zero; n * d];
+        let (dp, dq) = (dp.into_vec(), dq.into_vec());
+        let mut dx = ZeroedByChunk::new(n * d);
         let blocks = (dx.par_chunks_mut(chunk), dp.par_chunks(chunk), dq.par_chunks(chunk), xv.par_chunks(chunk));
         let dw_nodes = ordered_fold(
             blocks.into_par_iter(),
@@ -175,7 +176,7 @@ impl<T: Real> SliceOp<T, 3> for EdgeUpdate {
             },
         );
         add_assign(&mut g.w1[..2 * d * d], &dw_nodes);
-        Ok([Some(dx), Some(de), Some(g.pack(3 * d, d))])
+        Ok([Some(dx.into_vec()), Some(de), Some(g.pack(3 * d, d))])
     }
 }
 

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::{Saved, SavedSlot, Scratch};
 use crate::kernels::{
-    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, matmul, packed_len, tail_backward, tail_forward,
+    BLOCK_ROWS, MlpGrads, MlpWeights, Real, TailState, ZeroedByChunk, matmul, packed_len, tail_backward, tail_forward,
 };
 
 /// New node states (N×D) from node states `x` and aggregated messages `a` (both N×D) and the
@@ -54,12 +54,11 @@ impl<T: Real> SliceOp<T, 3> for NodeUpdate {
             matmul(rows, d, d, a, false, w.w1_rows(d..2 * d), false, st.h1, true);
             tail_forward(&w, x, st, out);
         };
-        let zero = T::from_f64(0.0);
         let chunk = BLOCK_ROWS * d;
-        let mut out = vec![zero; n * d];
+        let mut out = ZeroedByChunk::new(n * d);
         if self.save {
             let (mut h1, mut h2, mut mean, mut rstd) =
-                (vec![zero; n * d], vec![zero; n * d], vec![zero; n], vec![zero; n]);
+                (ZeroedByChunk::new(n * d), ZeroedByChunk::new(n * d), ZeroedByChunk::new(n), ZeroedByChunk::new(n));
             (
                 out.par_chunks_mut(chunk),
                 x.par_chunks(chunk),
@@ -72,10 +71,10 @@ impl<T: Real> SliceOp<T, 3> for NodeUpdate {
                 .into_par_iter()
                 .for_each(|(out, x, a, h1, h2, mean, rstd)| block(x, a, TailState { h1, h2, mean, rstd }, out));
             self.saved.put(Saved {
-                h1: T::to_cpu_storage_owned(h1),
-                h2: T::to_cpu_storage_owned(h2),
-                mean: T::to_cpu_storage_owned(mean),
-                rstd: T::to_cpu_storage_owned(rstd),
+                h1: T::to_cpu_storage_owned(h1.into_vec()),
+                h2: T::to_cpu_storage_owned(h2.into_vec()),
+                mean: T::to_cpu_storage_owned(mean.into_vec()),
+                rstd: T::to_cpu_storage_owned(rstd.into_vec()),
             })?;
         } else {
             (out.par_chunks_mut(chunk), x.par_chunks(chunk), a.par_chunks(chunk)).into_par_iter().for_each_init(
@@ -83,7 +82,7 @@ impl<T: Real> SliceOp<T, 3> for NodeUpdate {
                 |scratch, (out, x, a)| block(x, a, scratch.state(x.len() / d, d), out),
             );
         }
-        Ok((out, Shape::from((n, d))))
+        Ok((out.into_vec(), Shape::from((n, d))))
     }
 
     fn backward(
@@ -107,7 +106,7 @@ impl<T: Real> SliceOp<T, 3> for NodeUpdate {
         let w = MlpWeights::unpack(tv, 2 * d, d);
         let zero = T::from_f64(0.0);
         let chunk = BLOCK_ROWS * d;
-        let mut da = vec![zero; n * d];
+        let mut da = ZeroedByChunk::new(n * d);
         let blocks = (
             dx.par_chunks_mut(chunk),
             da.par_chunks_mut(chunk),
@@ -133,7 +132,7 @@ impl<T: Real> SliceOp<T, 3> for NodeUpdate {
             },
             |(a, scratch), (b, _)| (a.merge(b), scratch),
         );
-        Ok([Some(dx), Some(da), Some(g.pack(2 * d, d))])
+        Ok([Some(dx), Some(da.into_vec()), Some(g.pack(2 * d, d))])
     }
 }
 

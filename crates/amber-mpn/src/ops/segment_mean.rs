@@ -8,7 +8,7 @@ use candle_core::{Layout, Result, Shape, Tensor, bail};
 use rayon::prelude::*;
 
 use crate::graph::Topology;
-use crate::kernels::{BLOCK_ROWS, Real, segment_sum};
+use crate::kernels::{BLOCK_ROWS, Real, ZeroedByChunk, segment_sum};
 
 /// Mean of the rows of `e` (E×D) over each node's incoming edges: N×D.
 pub(crate) fn segment_mean(e: &Tensor, topology: &Arc<Topology>) -> Result<Tensor> {
@@ -33,7 +33,7 @@ impl SegmentMean {
 
     fn mean_rows<T: Real>(&self, e: &[T]) -> Vec<T> {
         let d = self.d;
-        let mut out = vec![T::from_f64(0.0); self.topology.num_nodes() * d];
+        let mut out = ZeroedByChunk::new(self.topology.num_nodes() * d);
         out.par_chunks_mut(BLOCK_ROWS * d).enumerate().for_each(|(b, out)| {
             segment_sum(out, e, self.topology.dst_offsets(), None, b * BLOCK_ROWS, d);
             for (i, o) in out.chunks_exact_mut(d).enumerate() {
@@ -41,7 +41,7 @@ impl SegmentMean {
                 o.iter_mut().for_each(|v| *v *= inv);
             }
         });
-        out
+        out.into_vec()
     }
 
     fn spread_rows<T: Real>(&self, grad: &[T]) -> Vec<T> {
