@@ -121,13 +121,12 @@ where
             steps: card.inference_steps,
         };
         let (scores, summary) = scorer.score::<D, P>(held_out, Some(fold.index), &args.out)?;
-        let log_ratio = scores.iter().map(|p| p.element_ratio().ln()).sum::<f64>() / scores.len() as f64;
         fold_scores.push(FoldScore {
             fold: fold.index,
             model: model_dir,
             held_out: names,
             normalised_dcd: summary.final_normalised_dcd().unwrap_or(f64::NAN),
-            element_ratio: log_ratio.exp(),
+            element_ratio: element_ratio(&scores),
             training_seconds: trained.seconds,
         });
         parts.extend(scores);
@@ -156,6 +155,11 @@ fn check_held_out(dir: &Path, names: &[String]) -> anyhow::Result<()> {
     write_json(&path, &names)
 }
 
+/// The geometric mean over `parts` of their final elements over the expert's.
+fn element_ratio(parts: &[PartScore]) -> f64 {
+    (parts.iter().map(|p| p.element_ratio().ln()).sum::<f64>() / parts.len() as f64).exp()
+}
+
 fn write_outputs(
     args: &CrossValidateArgs,
     config: &MethodConfig,
@@ -163,7 +167,7 @@ fn write_outputs(
     parts: &[PartScore],
 ) -> anyhow::Result<()> {
     let mean = parts.iter().map(|p| p.evaluation.last().normalised_dcd).sum::<f64>() / parts.len() as f64;
-    let element_ratio = (parts.iter().map(|p| p.element_ratio().ln()).sum::<f64>() / parts.len() as f64).exp();
+    let element_ratio = element_ratio(parts);
     let json = serde_json::json!({
         "data": args.data, "folds": folds, "config": config, "normalised_dcd": mean,
         "element_ratio": element_ratio, "parts": parts,
