@@ -7,7 +7,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use amber_experiments::{ModelCard, Task, train_folder, write_atomic, write_json};
+use amber_experiments::{Task, train_folder, write_atomic, write_json};
 use amber_mesh::Mesh;
 use amber_stdx::read_json;
 use amber_tasks::folder::{DatasetSettings, Fold, FolderDomain, Split, mesh_dimension, read_experts};
@@ -92,7 +92,8 @@ where
     let (mut parts, mut fold_scores) = (Vec::new(), Vec::new());
     for fold in folds {
         let dir = args.out.join(format!("fold{}", fold.index));
-        let (_, held_out) = fold.split(experts.clone());
+        let held_out: Vec<_> =
+            experts.iter().enumerate().filter(|(i, _)| fold.holds_out(*i)).map(|(_, e)| e.clone()).collect();
         let names: Vec<String> = held_out.iter().map(|e| e.name.clone()).collect();
         check_held_out(&dir, &names)?;
         let label = format!("{} fold {} of {}", args.training.method, fold.index, fold.count);
@@ -107,9 +108,7 @@ where
             names.join(", ")
         );
         let card = Trained { seconds: trained.seconds, initial_size: trained.initial_size, data };
-        args.training.write_card(&model_dir, Task::Folder { dimension: D }, config, card)?;
-
-        let card = ModelCard::read(&model_dir)?;
+        let card = args.training.write_card(&model_dir, Task::Folder { dimension: D }, config, card)?;
         let mut model = TrainedModel::load(&model_dir)
             .with_context(|| format!("{}: cannot load the model", model_dir.display()))?;
         // As `amber evaluate` does: a field over the budget is scaled to it, not skipped.

@@ -69,14 +69,15 @@ impl TrainingArgs {
         Ok(config)
     }
 
-    /// Writes the card of the model trained with `config` into `model` (a run's model directory).
+    /// Writes the card of the model trained with `config` into `model` (a run's model directory)
+    /// and returns it.
     pub fn write_card(
         &self,
         model: &Path,
         task: amber_experiments::Task,
         config: &MethodConfig,
         trained: Trained,
-    ) -> anyhow::Result<()> {
+    ) -> anyhow::Result<ModelCard> {
         let MethodConfig::Amber(amber) = config else { bail!("amber trains AMBER models") };
         let card = ModelCard {
             task,
@@ -89,7 +90,8 @@ impl TrainingArgs {
             training_seconds: trained.seconds,
             evaluation: None,
         };
-        card.write(model)
+        card.write(model)?;
+        Ok(card)
     }
 }
 
