@@ -16,7 +16,7 @@ use amber_meshgen::{
 };
 use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
-use amber_stdx::quantile;
+use amber_stdx::{median, quantile};
 use amber_tasks::cad::is_cad;
 use amber_tasks::part::{
     FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, cad_face_tags, polygon_side_tags, read_polygon_domain,
@@ -45,7 +45,8 @@ pub struct MeshArgs {
     #[arg(long, conflicts_with = "size", required_unless_present = "size")]
     model: Option<String>,
     /// Instead of a model: a constant size (edge length), or a mesh file whose element sizes define
-    /// a piecewise-constant field (a `size` cell array overrides them). 2D geometries only.
+    /// a piecewise-constant field (a `size` cell array overrides them), triangles for a 2D
+    /// geometry and tetrahedra for a solid: a field from a solver's error estimate, say.
     #[arg(long, allow_hyphen_values = true)]
     size: Option<String>,
     /// Generation steps (default: the model's own number).
@@ -462,47 +463,70 @@ fn output_options(args: &MeshArgs) -> WriteOptions {
     WriteOptions { order: args.order, ..WriteOptions::default() }
 }
 
-/// `--size`: a 2D geometry meshed from a given field, or a 3D one from a constant size.
+/// `--size`: a geometry meshed from a given field, a constant or a mesh file's sizes.
 fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
     let geometry = args.geometry.as_deref().unwrap_or("lshape");
     let start = Instant::now();
-    if is_solid(geometry) {
-        let h: f64 = size.parse().with_context(|| format!("--size {size}: a 3D geometry takes a constant size"))?;
-        let surface = read_solid_surface(Path::new(geometry), args.feature_angle, h)?;
-        let params = Mesh3dParams::default().with_max_elements(args.max_elements);
-        let mesh = generate_3d(&surface, &ConstantSize(h), &params).context("mesh generation failed")?;
-        let facet_tags = cad_face_tags(&SurfaceDistance::new(&surface), &mesh);
-        write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
-        eprintln!(
-            "{} tetrahedra in {:.3} s; wrote {}",
-            mesh.num_elements(),
-            start.elapsed().as_secs_f64(),
-            args.output().display()
-        );
-        return Ok(());
-    }
-    let domain = planar_domain(args)?;
-    let params = Mesh2dParams::default().with_max_elements(args.max_elements);
-    let (mesh, report) = match size.parse::<f64>() {
-        Ok(h) => mesh_with(&domain, &ConstantSize(h), &params)?,
-        Err(_) => {
-            let (field_mesh, sizes) = read_sizing_mesh(Path::new(size))?;
-            mesh_with(&domain, &MeshSizing::new(&field_mesh, sizes), &params)?
+    let (elements, report) = if is_solid(geometry) {
+        match size.parse::<f64>() {
+            Ok(h) => mesh_solid_with(args, geometry, &ConstantSize(h), h)?,
+            Err(_) => {
+                let (field_mesh, sizes) = read_sizing_mesh::<3>(Path::new(size))?;
+                let typical_size = median(&sizes);
+                mesh_solid_with(args, geometry, &MeshSizing::new(&field_mesh, sizes), typical_size)?
+            }
+        }
+    } else {
+        let domain = planar_domain(args)?;
+        match size.parse::<f64>() {
+            Ok(h) => mesh_planar_with(args, &domain, &ConstantSize(h))?,
+            Err(_) => {
+                let (field_mesh, sizes) = read_sizing_mesh::<2>(Path::new(size))?;
+                mesh_planar_with(args, &domain, &MeshSizing::new(&field_mesh, sizes))?
+            }
         }
     };
-    let seconds = start.elapsed().as_secs_f64();
-    let facet_tags = polygon_side_tags(&PolygonDistance::new(&domain), &mesh);
-    write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
     eprintln!(
-        "{} triangles in {seconds:.3} s; size ratio median {:.3} (p10 {:.3}, p90 {:.3}); mean smallest angle {:.1}°; wrote {}",
-        mesh.num_elements(),
+        "{elements} {} in {:.3} s; size ratio median {:.3} (p10 {:.3}, p90 {:.3}); mean smallest {} {:.1}°; wrote {}",
+        if is_solid(geometry) { "tetrahedra" } else { "triangles" },
+        start.elapsed().as_secs_f64(),
         report.size_ratio_median,
         report.size_ratio_p10,
         report.size_ratio_p90,
+        if is_solid(geometry) { "dihedral angle" } else { "angle" },
         report.mean_min_angle,
         args.output().display()
     );
     Ok(())
+}
+
+/// Meshes the solid `geometry` (a CAD file tessellated at about `typical_size`) to `field` and
+/// writes it: its element count and how its sizes follow the field.
+fn mesh_solid_with(
+    args: &MeshArgs,
+    geometry: &str,
+    field: &impl SizingField<3>,
+    typical_size: f64,
+) -> anyhow::Result<(usize, QualityReport)> {
+    let surface = read_solid_surface(Path::new(geometry), args.feature_angle, typical_size)?;
+    let params = Mesh3dParams::default().with_max_elements(args.max_elements);
+    let mesh = generate_3d(&surface, field, &params).context("mesh generation failed")?;
+    let facet_tags = cad_face_tags(&SurfaceDistance::new(&surface), &mesh);
+    write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
+    Ok((mesh.num_elements(), QualityReport::measure(&mesh, field)))
+}
+
+/// Meshes the polygon `domain` to `field` and writes it, as [`mesh_solid_with`].
+fn mesh_planar_with(
+    args: &MeshArgs,
+    domain: &PolygonDomain,
+    field: &impl SizingField<2>,
+) -> anyhow::Result<(usize, QualityReport)> {
+    let params = Mesh2dParams::default().with_max_elements(args.max_elements);
+    let mesh = generate_2d(domain, field, &params).context("mesh generation failed")?;
+    let facet_tags = polygon_side_tags(&PolygonDistance::new(domain), &mesh);
+    write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
+    Ok((mesh.num_elements(), QualityReport::measure(&mesh, field)))
 }
 
 /// Whether `geometry` names a solid: a surface file, or a mesh file holding tetrahedra.
@@ -512,16 +536,6 @@ fn is_solid(geometry: &str) -> bool {
     matches!(extension.as_deref(), Some("stl" | "obj"))
         || is_cad(path)
         || matches!(read_any_mesh(path), Ok(AnyMesh::Three(..)))
-}
-
-fn mesh_with<F: SizingField<2>>(
-    domain: &PolygonDomain,
-    field: &F,
-    params: &Mesh2dParams,
-) -> anyhow::Result<(Mesh2, QualityReport)> {
-    let mesh = generate_2d(domain, field, params).context("mesh generation failed")?;
-    let report = QualityReport::measure(&mesh, field);
-    Ok((mesh, report))
 }
 
 fn parse_refine_box(text: &str) -> Result<RefineBox, String> {
@@ -640,9 +654,9 @@ fn planar_domain(args: &MeshArgs) -> anyhow::Result<PolygonDomain> {
     })
 }
 
-fn read_sizing_mesh(path: &Path) -> anyhow::Result<(Mesh2, Vec<f64>)> {
-    let (mesh, data) = read_mesh_with_data::<2>(path)
-        .with_context(|| format!("--size {}: not a number and not a readable mesh", path.display()))?;
+fn read_sizing_mesh<const D: usize>(path: &Path) -> anyhow::Result<(Mesh<D>, Vec<f64>)> {
+    let (mesh, data) = read_mesh_with_data::<D>(path)
+        .with_context(|| format!("--size {}: neither a number nor a readable {D}D mesh", path.display()))?;
     let sizes = data.cell.get("size").cloned().unwrap_or_else(|| mesh.sizes());
     if sizes.len() != mesh.num_elements() {
         bail!(

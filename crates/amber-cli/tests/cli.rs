@@ -47,6 +47,52 @@ fn meshes_an_lshape_and_remeshes_from_the_result() {
     assert!(!output.status.success() && stderr.contains("second-order"), "{stderr}");
 }
 
+/// `--size` with a tet mesh whose `size` cell array asks for fine tets in the core of a cube:
+/// the solid is meshed fine there, not at its skin's sizes carried inwards.
+#[test]
+fn meshes_a_solid_to_a_field_given_as_a_tet_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("cube.json");
+    std::fs::write(
+        &cube,
+        r#"{"dimension": 3,
+        "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [0, 0, 1], [1, 0, 1], [0, 1, 1], [1, 1, 1]],
+        "elements": [[0, 1, 3, 7], [0, 1, 7, 5], [0, 2, 7, 3], [0, 2, 6, 7], [0, 4, 5, 7], [0, 4, 7, 6]]}"#,
+    )
+    .unwrap();
+    let uniform = dir.path().join("uniform.vtu");
+    assert!(amber().arg("mesh").arg(&cube).args(["--size", "0.15", "-o"]).arg(&uniform).status().unwrap().success());
+    let uniform = amber_mesh::read_mesh::<3>(&uniform).unwrap();
+
+    let from_centre = |p: [f64; 3]| p.iter().map(|x| (x - 0.5) * (x - 0.5)).sum::<f64>().sqrt();
+    let h = |p: [f64; 3]| 0.04 + 0.16 * (from_centre(p) / 0.5).min(1.0);
+    let field = dir.path().join("field.vtu");
+    let sizes: Vec<f64> = uniform.midpoints().into_iter().map(h).collect();
+    amber_mesh::write_mesh(&uniform, &field, &amber_mesh::MeshData::new().with_cell("size", sizes)).unwrap();
+    let graded = dir.path().join("graded.msh");
+    let output = amber().arg("mesh").arg(&cube).arg("--size").arg(&field).arg("-o").arg(&graded).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success() && stderr.contains("tetrahedra") && stderr.contains("size ratio"), "{stderr}");
+    let (mesh, data) = amber_mesh::read_mesh_with_data::<3>(&graded).unwrap();
+    assert!((mesh.total_volume() - 1.0).abs() < 1e-9, "volume {}", mesh.total_volume());
+    let faces: std::collections::BTreeSet<i32> = data.facet_tags.values().copied().collect();
+    assert_eq!(faces.len(), 6, "{faces:?}");
+    let mut core: Vec<f64> = (0..mesh.num_elements())
+        .filter(|&e| from_centre(mesh.midpoint(e)) < 0.2)
+        .map(|e| mesh.size(e) / h(mesh.midpoint(e)))
+        .collect();
+    core.sort_by(f64::total_cmp);
+    let median = core[core.len() / 2];
+    assert!((0.7..1.4).contains(&median), "core tets at {median} of the field ({} of them)", core.len());
+
+    // A field of triangles does not size a solid.
+    let flat = dir.path().join("flat.vtu");
+    assert!(amber().args(["mesh", "--size", "0.2", "-o"]).arg(&flat).status().unwrap().success());
+    let output = amber().arg("mesh").arg(&cube).arg("--size").arg(&flat).arg("-o").arg(&graded).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("flat.vtu"), "{stderr}");
+}
+
 #[test]
 fn converts_between_formats_in_the_dimension_of_the_file() {
     let dir = tempfile::tempdir().unwrap();
