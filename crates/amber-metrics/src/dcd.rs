@@ -103,7 +103,12 @@ fn z_order<const K: usize>(points: &[[f64; K]]) -> Vec<[f64; K]> {
     // A radix sort of (code, index) pairs moves a third of the bytes a sort of the points would
     // and is ~5× faster than a comparison sort; it keeps the input order within a cell, so
     // cells holding several points are then ordered by coordinates.
-    radsort::sort_by_key(&mut keyed, |&(code, _)| code);
+    if K * bits <= 32 {
+        // The same order from half the radix passes: the codes' upper half is zero.
+        radsort::sort_by_key(&mut keyed, |&(code, _)| code as u32);
+    } else {
+        radsort::sort_by_key(&mut keyed, |&(code, _)| code);
+    }
     let coordinates = |(_, index): &(u64, u32)| &points[*index as usize];
     for cell in keyed.chunk_by_mut(|a, b| a.0 == b.0).filter(|cell| cell.len() > 1) {
         cell.sort_unstable_by(|a, b| {
