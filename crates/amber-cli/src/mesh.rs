@@ -64,19 +64,20 @@ pub struct MeshArgs {
     /// Hold the final step's sizing field at or below this size.
     #[arg(long)]
     max_size: Option<f64>,
-    /// A box where the final mesh's elements are to be no larger than SIZE (a bolt hole, a weld,
-    /// where the stresses matter): `X0,Y0,X1,Y1,SIZE` in 2D, `X0,Y0,Z0,X1,Y1,Z1,SIZE` in 3D, the
-    /// box's lower and upper corners. The last step's field is held at SIZE on every element of
-    /// the mesh before it that meets the box (so the refinement may reach one such element
-    /// beyond it); --elements counts the box's elements in. May be given more than once.
+    /// A box where 90 % of the final mesh's elements are to be no larger than SIZE (a bolt hole,
+    /// a weld, where the stresses matter): `X0,Y0,X1,Y1,SIZE` in 2D, `X0,Y0,Z0,X1,Y1,Z1,SIZE` in
+    /// 3D, the box's lower and upper corners. The last step's field is held at 0.85 × SIZE (2D)
+    /// or 0.75 × SIZE (3D), since elements scatter around their field, on every element of the
+    /// mesh before it that meets the box (so the refinement may reach one such element beyond
+    /// it); --elements counts the box's elements in. May be given more than once.
     #[arg(long, value_parser = parse_refine_box, value_name = "CORNERS,SIZE", allow_hyphen_values = true)]
     refine_box: Vec<RefineBox>,
-    /// A piece of the boundary where the final mesh's elements are to be no larger than SIZE (a
-    /// contact face, a hole's wall, a loaded edge): `FACE,SIZE`, FACE the number of a CAD face of
-    /// a solid or of a side of a polygon, as in the written mesh's `boundary_<FACE>` groups. The
-    /// last step's field is held at SIZE on every element of the mesh before it with a vertex on
-    /// the face, a layer as deep as that mesh's elements there; --elements counts them in. May
-    /// be given more than once.
+    /// A piece of the boundary where 90 % of the final mesh's elements are to be no larger than
+    /// SIZE (a contact face, a hole's wall, a loaded edge): `FACE,SIZE`, FACE the number of a CAD
+    /// face of a solid or of a side of a polygon, as in the written mesh's `boundary_<FACE>`
+    /// groups. The last step's field is held at the fraction of SIZE of --refine-box on every
+    /// element of the mesh before it with a vertex on the face, a layer as deep as that mesh's
+    /// elements there; --elements counts them in. May be given more than once.
     #[arg(long, value_parser = parse_refine_face, value_name = "FACE,SIZE")]
     refine_face: Vec<RefineFace>,
     /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,

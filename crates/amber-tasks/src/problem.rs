@@ -306,7 +306,7 @@ const ELEMENT_COUNT_ATTEMPTS: usize = 5;
 /// What a user allows a final mesh's sizing field (`amber mesh --min-size/--max-size/--refine-box/
 /// --refine-face`): a range (an explicit solver's time step is set by its smallest element; a
 /// contact or a result plot wants no element above a size), and boxes and boundary faces where
-/// elements are to be no larger than a size (a bolt hole, a weld, a contact face: where the
+/// 90 % of the elements are to be no larger than a size (a bolt hole, a weld, a contact face: where the
 /// stresses matter). They act after every other scaling, so the model still decides where
 /// elements go within them. What they add is the user's call, so the user caps the mesh they make
 /// (`--max-elements`), not the model's budget, which guards only the model's own field.
@@ -417,12 +417,13 @@ impl SizeBounds {
         h.clamp(self.min, self.max)
     }
 
-    /// `sizes`, one per element of `mesh` (a mesh of `domain`), moved into the range; at most a
-    /// box's size on every element whose bounding box meets the box, and a face's size on every
-    /// element with a vertex on the face. Panics if a box is not of dimension `D` (callers check
-    /// it against the geometry).
+    /// `sizes`, one per element of `mesh` (a mesh of `domain`), moved into the range; at most
+    /// `refined_field` of a box's size on every element whose bounding box meets the box, and
+    /// of a face's size on every element with a vertex on the face. Panics if a box is not of
+    /// dimension `D` (callers check it against the geometry).
     pub fn apply<const D: usize, P: Domain<D> + ?Sized>(&self, domain: &P, mesh: &Mesh<D>, sizes: &mut [f64]) {
         sizes.iter_mut().for_each(|h| *h = self.clamp(*h));
+        let refined = |max_size: f64| refined_field::<D>(max_size).max(self.min);
         if !self.faces.is_empty() {
             // The smallest size any refined face asks of each vertex.
             let mut vertex_size = vec![f64::INFINITY; mesh.num_vertices()];
@@ -430,7 +431,7 @@ impl SizeBounds {
                 for refine in self.faces.iter().filter(|f| f.face == tag) {
                     for &v in &facet {
                         let h = &mut vertex_size[v as usize];
-                        *h = h.min(refine.max_size);
+                        *h = h.min(refined(refine.max_size));
                     }
                 }
             }
@@ -451,11 +452,20 @@ impl SizeBounds {
             let (lo, hi) = (corner(f64::min, f64::INFINITY), corner(f64::max, f64::NEG_INFINITY));
             for b in &self.boxes {
                 if (0..D).all(|k| lo[k] <= b.hi[k] && hi[k] >= b.lo[k]) {
-                    *h = h.min(b.max_size);
+                    *h = h.min(refined(b.max_size));
                 }
             }
         }
     }
+}
+
+/// The field that meshes a refined region (a box, a face) with 90 % of its elements no larger
+/// than `max_size`: the generators' elements scatter around the field, and more so in 3D, where
+/// the surface remesher keeps edges below 4/3 of it and TetGen grades the thin refined layer
+/// into its coarser surroundings. The factors are measured (docs/PROFILES.md): at the field
+/// itself the 90th percentile came out at 1.16–1.18× in 2D and 1.31–1.46× in 3D.
+fn refined_field<const D: usize>(max_size: f64) -> f64 {
+    max_size * if D == 3 { 0.75 } else { 0.85 }
 }
 
 /// A new mesh of `domain` whose sizes follow the shape of the field `sizes` on `mesh`, scaled by
@@ -578,16 +588,18 @@ mod tests {
         assert!(near > made.num_elements() * 6 / 10, "the grading is kept: {near} of {}", made.num_elements());
     }
 
-    /// The median element size of `mesh` over the elements whose midpoint is `inside`.
-    fn median_size_where(mesh: &Mesh<2>, inside: impl Fn([f64; 2]) -> bool) -> f64 {
+    /// The `q` quantile of the element sizes of `mesh` over the elements whose midpoint is
+    /// `inside`.
+    fn size_quantile_where(mesh: &Mesh<2>, q: f64, inside: impl Fn([f64; 2]) -> bool) -> f64 {
         let mut h: Vec<f64> =
             mesh.midpoints().iter().zip(mesh.sizes()).filter(|(x, _)| inside(**x)).map(|(_, h)| h).collect();
         h.sort_by(f64::total_cmp);
-        quantile(&h, 0.5)
+        quantile(&h, q)
     }
 
     /// A uniform field with a box asking for a fifth of its size: the count still lands on the
-    /// target, the box's elements have its size, and the rest of the square is coarser.
+    /// target, 90 % of the box's elements are no larger than its size (and not far below it),
+    /// and the rest of the square is coarser.
     #[test]
     fn a_refinement_box_holds_its_elements_while_the_count_is_met() {
         let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![]).unwrap();
@@ -599,10 +611,11 @@ mod tests {
         let made = mesh_to_element_count(&square, mesh, &sizes, 3_000, &bounds, 1_000_000).unwrap();
         let ratio = made.num_elements() as f64 / 3_000.0;
         assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements", made.num_elements());
-        let in_box = median_size_where(&made, |x| (0.2..0.4).contains(&x[0]) && (0.2..0.4).contains(&x[1]));
-        let far = median_size_where(&made, |x| x[0] > 0.7 && x[1] > 0.7);
-        assert!((0.008..0.012).contains(&in_box), "the box's median size {in_box}");
-        assert!(far > 2.5 * in_box, "far from the box {far}, in it {in_box}");
+        let in_box = |q| size_quantile_where(&made, q, |x| (0.2..0.4).contains(&x[0]) && (0.2..0.4).contains(&x[1]));
+        let (median, p90) = (in_box(0.5), in_box(0.9));
+        let far = size_quantile_where(&made, 0.5, |x| x[0] > 0.7 && x[1] > 0.7);
+        assert!(p90 <= 0.0102 && median > 0.0075, "the box's sizes: median {median}, 90 % {p90}");
+        assert!(far > 2.5 * median, "far from the box {far}, in it {median}");
 
         let bad = |lo: Vec<f64>, hi: Vec<f64>, max_size| {
             SizeBounds::new(Some(0.005), None).unwrap().with_box(RefineBox { lo, hi, max_size }).unwrap_err()
@@ -614,8 +627,8 @@ mod tests {
     }
 
     /// A uniform field with the square's bottom side asking for a fifth of its size: the count
-    /// still lands on the target, the elements along that side have its size, the other sides'
-    /// do not, and a face's size is checked as a box's.
+    /// still lands on the target, 90 % of the elements along that side are no larger than its
+    /// size, the other sides' are larger, and a face's size is checked as a box's.
     #[test]
     fn a_refined_face_holds_its_elements_while_the_count_is_met() {
         let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![]).unwrap();
@@ -629,13 +642,14 @@ mod tests {
             .unwrap();
         let bounds = SizeBounds::default().with_face(RefineFace { face: bottom, max_size: 0.01 }).unwrap();
         let made =
-            mesh_to_element_count(&square, mesh, &vec![0.05; mesh.num_elements()], 3_000, &bounds, 1_000_000).unwrap();
-        let ratio = made.num_elements() as f64 / 3_000.0;
+            mesh_to_element_count(&square, mesh, &vec![0.05; mesh.num_elements()], 4_000, &bounds, 1_000_000).unwrap();
+        let ratio = made.num_elements() as f64 / 4_000.0;
         assert!((ratio - 1.0).abs() <= ELEMENT_COUNT_TOLERANCE, "{} elements", made.num_elements());
-        let along = median_size_where(&made, |x| x[1] < 0.03);
-        let top = median_size_where(&made, |x| x[1] > 0.97);
-        assert!((0.008..0.012).contains(&along), "the bottom side's median size {along}");
-        assert!(top > 2.5 * along, "along the top side {top}, the bottom {along}");
+        let along = |q| size_quantile_where(&made, q, |x| x[1] < 0.03);
+        let (median, p90) = (along(0.5), along(0.9));
+        let top = size_quantile_where(&made, 0.5, |x| x[1] > 0.97);
+        assert!(p90 <= 0.0102 && median > 0.0075, "the bottom side's sizes: median {median}, 90 % {p90}");
+        assert!(top > 2.5 * median, "along the top side {top}, the bottom {median}");
 
         let bounds = SizeBounds::new(Some(0.005), None).unwrap();
         let bad = |max_size| bounds.clone().with_face(RefineFace { face: bottom, max_size }).unwrap_err();
@@ -644,14 +658,14 @@ mod tests {
     }
 
     /// A field over the model's budget is scaled to it before a refinement box acts: the box's
-    /// elements keep its size, and only the model's field pays for the budget.
+    /// elements keep within its size, and only the model's field pays for the budget.
     #[test]
     fn a_refinement_box_acts_after_the_budget_guard() {
         let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![]).unwrap();
         let square = PlanarPart::new("square".into(), domain, 0.1).unwrap();
         let mesh = square.initial_mesh();
         let limits = MeshLimits { min_size: 1e-3, max_elements: 500, scale_to_budget: true, final_step_scale: 1.0 };
-        let refine = RefineBox { lo: vec![0.0, 0.0], hi: vec![0.2, 0.2], max_size: 0.01 };
+        let refine = RefineBox { lo: vec![0.0, 0.0], hi: vec![0.2, 0.2], max_size: 0.012 };
         let bounds = SizeBounds::default().with_box(refine).unwrap();
         // An estimate of 924 elements, about twice the budget, before the box adds about 900.
         let StepOutcome::Meshed(made) =
@@ -659,9 +673,9 @@ mod tests {
         else {
             panic!("not meshed")
         };
-        let in_box = median_size_where(&made, |x| x[0] < 0.2 && x[1] < 0.2);
-        let far = median_size_where(&made, |x| x[0] > 0.6 && x[1] > 0.6);
-        assert!((0.008..0.012).contains(&in_box), "the box's median size {in_box}");
+        let in_box = size_quantile_where(&made, 0.9, |x| x[0] < 0.2 && x[1] < 0.2);
+        let far = size_quantile_where(&made, 0.5, |x| x[0] > 0.6 && x[1] > 0.6);
+        assert!((0.0096..0.0122).contains(&in_box), "the box's sizes at 90 %: {in_box}");
         assert!((0.06..0.085).contains(&far), "the budget's scale, 0.05 × √(924/475) = 0.070: {far}");
     }
 
