@@ -470,20 +470,25 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
     let start = Instant::now();
     let (elements, report) = if is_solid(geometry) {
         match size.parse::<f64>() {
-            Ok(h) => mesh_solid_with(args, geometry, &ConstantSize(h), h)?,
+            Ok(h) => mesh_solid_with(args, geometry, &ConstantSize(h), h).map(|(m, r)| (m.num_elements(), r))?,
             Err(_) => {
                 let (field_mesh, sizes) = read_sizing_mesh::<3>(Path::new(size))?;
                 let typical_size = median(&sizes);
-                mesh_solid_with(args, geometry, &MeshSizing::new(&field_mesh, sizes), typical_size)?
+                let (mesh, report) =
+                    mesh_solid_with(args, geometry, &MeshSizing::new(&field_mesh, sizes), typical_size)?;
+                warn_outside_field(&field_mesh, &mesh, size);
+                (mesh.num_elements(), report)
             }
         }
     } else {
         let domain = planar_domain(args)?;
         match size.parse::<f64>() {
-            Ok(h) => mesh_planar_with(args, &domain, &ConstantSize(h))?,
+            Ok(h) => mesh_planar_with(args, &domain, &ConstantSize(h)).map(|(m, r)| (m.num_elements(), r))?,
             Err(_) => {
                 let (field_mesh, sizes) = read_sizing_mesh::<2>(Path::new(size))?;
-                mesh_planar_with(args, &domain, &MeshSizing::new(&field_mesh, sizes))?
+                let (mesh, report) = mesh_planar_with(args, &domain, &MeshSizing::new(&field_mesh, sizes))?;
+                warn_outside_field(&field_mesh, &mesh, size);
+                (mesh.num_elements(), report)
             }
         }
     };
@@ -502,19 +507,20 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
 }
 
 /// Meshes the solid `geometry` (a CAD file tessellated at about `typical_size`) to `field` and
-/// writes it: its element count and how its sizes follow the field.
+/// writes it: the mesh and how its sizes follow the field.
 fn mesh_solid_with(
     args: &MeshArgs,
     geometry: &str,
     field: &impl SizingField<3>,
     typical_size: f64,
-) -> anyhow::Result<(usize, QualityReport)> {
+) -> anyhow::Result<(Mesh3, QualityReport)> {
     let surface = read_solid_surface(Path::new(geometry), args.feature_angle, typical_size)?;
     let params = Mesh3dParams::default().with_max_elements(args.max_elements);
     let mesh = generate_3d(&surface, field, &params).context("mesh generation failed")?;
     let facet_tags = cad_face_tags(&SurfaceDistance::new(&surface), &mesh);
     write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
-    Ok((mesh.num_elements(), QualityReport::measure(&mesh, field)))
+    let report = QualityReport::measure(&mesh, field);
+    Ok((mesh, report))
 }
 
 /// Meshes the polygon `domain` to `field` and writes it, as [`mesh_solid_with`].
@@ -522,12 +528,30 @@ fn mesh_planar_with(
     args: &MeshArgs,
     domain: &PolygonDomain,
     field: &impl SizingField<2>,
-) -> anyhow::Result<(usize, QualityReport)> {
+) -> anyhow::Result<(Mesh2, QualityReport)> {
     let params = Mesh2dParams::default().with_max_elements(args.max_elements);
     let mesh = generate_2d(domain, field, &params).context("mesh generation failed")?;
     let facet_tags = polygon_side_tags(&PolygonDistance::new(domain), &mesh);
     write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
-    Ok((mesh.num_elements(), QualityReport::measure(&mesh, field)))
+    let report = QualityReport::measure(&mesh, field);
+    Ok((mesh, report))
+}
+
+/// Warns when more than 1 % of the vertices of `mesh` lie outside the bounding box of the mesh
+/// that gave its sizes (grown by 1 % of its diagonal): there the field is its nearest element's,
+/// and a field mesh of another part or in other units goes unnoticed otherwise.
+fn warn_outside_field<const D: usize>(field_mesh: &Mesh<D>, mesh: &Mesh<D>, field_path: &str) {
+    let Some((lo, hi)) = field_mesh.bounding_box() else { return };
+    let margin = 0.01 * (0..D).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let outside = mesh.vertices().iter().filter(|p| (0..D).any(|k| p[k] < lo[k] - margin || p[k] > hi[k] + margin));
+    let share = outside.count() as f64 / mesh.num_vertices().max(1) as f64;
+    if share > 0.01 {
+        eprintln!(
+            "warning: {:.0} % of the mesh lies outside the box of the field mesh {field_path}, where each size is its \
+             nearest element's: is the field of this geometry, in its units?",
+            100.0 * share
+        );
+    }
 }
 
 /// Whether `geometry` names a solid: a surface file, or a mesh file holding tetrahedra.

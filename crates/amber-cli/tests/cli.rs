@@ -73,6 +73,7 @@ fn meshes_a_solid_to_a_field_given_as_a_tet_mesh() {
     let output = amber().arg("mesh").arg(&cube).arg("--size").arg(&field).arg("-o").arg(&graded).output().unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success() && stderr.contains("tetrahedra") && stderr.contains("size ratio"), "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
     let (mesh, data) = amber_mesh::read_mesh_with_data::<3>(&graded).unwrap();
     assert!((mesh.total_volume() - 1.0).abs() < 1e-9, "volume {}", mesh.total_volume());
     let faces: std::collections::BTreeSet<i32> = data.facet_tags.values().copied().collect();
@@ -84,6 +85,15 @@ fn meshes_a_solid_to_a_field_given_as_a_tet_mesh() {
     core.sort_by(f64::total_cmp);
     let median = core[core.len() / 2];
     assert!((0.7..1.4).contains(&median), "core tets at {median} of the field ({} of them)", core.len());
+
+    // A field mesh beside the geometry (another part, other units) meshes, with a warning.
+    let moved: Vec<[f64; 3]> = uniform.vertices().iter().map(|p| [p[0] + 5.0, p[1], p[2]]).collect();
+    let moved = amber_mesh::Mesh3::new(moved, uniform.cells().to_vec()).unwrap();
+    let beside = dir.path().join("beside.vtu");
+    amber_mesh::write_mesh(&moved, &beside, &amber_mesh::MeshData::new()).unwrap();
+    let output = amber().arg("mesh").arg(&cube).arg("--size").arg(&beside).arg("-o").arg(&graded).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success() && stderr.contains("100 % of the mesh lies outside"), "{stderr}");
 
     // A field of triangles does not size a solid.
     let flat = dir.path().join("flat.vtu");
