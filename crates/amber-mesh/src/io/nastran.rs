@@ -8,7 +8,8 @@
 //!
 //! The writer writes free-field cards (GRID, CTETRA or CTRIA3; second order: CTETRA with its six
 //! edge grids, four of them on a `+` continuation line, or CTRIA6) with coordinates in their
-//! shortest round-trip form, so a mesh reads back bit-exactly.
+//! shortest round-trip form where it fits a large field (16 characters), so such a mesh reads
+//! back bit-exactly, and else to 5e-11 relative (a coordinate's exponent of one or two digits).
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -116,7 +117,8 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
 pub(super) fn write<const D: usize>(nodes: &Nodes<D>, w: &mut impl Write) -> std::io::Result<()> {
     writeln!(w, "$ written by amber\nBEGIN BULK")?;
     for (i, p) in nodes.points().enumerate() {
-        writeln!(w, "GRID,{},,{:?},{:?},{:?}", i + 1, p[0], p[1], if D == 3 { p[2] } else { 0.0 })?;
+        let [x, y, z] = [p[0], p[1], if D == 3 { p[2] } else { 0.0 }].map(large_field_real);
+        writeln!(w, "GRID,{},,{x},{y},{z}", i + 1)?;
     }
     let card = match (D, nodes.is_quadratic()) {
         (2, false) => "CTRIA3",
@@ -136,6 +138,22 @@ pub(super) fn write<const D: usize>(nodes: &Nodes<D>, w: &mut impl Write) -> std
     }
     writeln!(w, "ENDDATA")
 }
+
+/// `x` in at most 16 characters, a large field's width, which is what MSC Nastran reads a
+/// free-field entry into (and some readers take only 8): the shortest form that reads back
+/// bit-exactly when it fits, else the most significant digits that fit in scientific notation
+/// (5e-11 relative at worst for exponents of one or two digits).
+fn large_field_real(x: f64) -> String {
+    let shortest = format!("{x:?}");
+    if shortest.len() <= LARGE_FIELD {
+        return shortest;
+    }
+    // Rounding near f64::MAX may overflow, which a shorter form avoids.
+    let fits = |s: &String| s.len() <= LARGE_FIELD && s.parse::<f64>().is_ok_and(f64::is_finite);
+    (1..=15).rev().map(|digits| format!("{x:.digits$e}")).find(fits).unwrap_or(shortest)
+}
+
+const LARGE_FIELD: usize = 16;
 
 /// The fields of one card: fixed columns (8 characters for the name, then 8 or, in large-field
 /// cards, 16 each), or comma-separated when the line has a comma. Field 0 is the card name;
@@ -188,6 +206,22 @@ mod tests {
     use super::*;
     use crate::io::ElementOrder;
     use crate::{Mesh2, Mesh3};
+
+    /// Coordinates whose shortest form is longer than a large field are written to fit it and
+    /// read back to 5e-11 relative (5e-9 with a three-digit exponent); short ones exactly.
+    #[test]
+    fn coordinates_fit_a_large_field() {
+        for x in [0.5, -1.0, 1e-5, 0.1 + 0.2, 1.0 / 3.0, -2.0 / 3.0e-300, 123456.78901234567, -1e-7 / 3.0, f64::MAX] {
+            let text = large_field_real(x);
+            let back: f64 = text.parse().unwrap();
+            let tolerance = if x.abs().log10().abs() >= 99.0 { 5e-9 } else { 5e-11 };
+            assert!(text.len() <= LARGE_FIELD, "{x}: {text}");
+            assert!((back - x).abs() <= tolerance * x.abs(), "{x}: {text}");
+            if format!("{x:?}").len() <= LARGE_FIELD {
+                assert_eq!(back, x, "{text}");
+            }
+        }
+    }
 
     fn parse(text: &str) -> Result<Mesh3, MeshError> {
         let path = Path::new("inline.nas");
@@ -284,10 +318,14 @@ GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nGRID,5,,1.,1.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA
         assert_eq!(mesh.num_elements(), 2, "the 10-node CTETRA by its corners");
         assert_eq!(data.dropped, std::collections::BTreeMap::from([("quad".into(), 1)]));
         assert_eq!(data.linearised, std::collections::BTreeMap::from([("tetra10".into(), 1)]));
-        let square = Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0 / 3.0, 1.0]], vec![0, 1, 2]).unwrap();
-        let mut bytes = Vec::new();
-        write(&Nodes::new(&square, ElementOrder::Linear), &mut bytes).unwrap();
-        assert_eq!(read(path, &bytes).unwrap().finish::<2>(path).unwrap().0, square);
+        let triangle = |x| Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [x, 1.0]], vec![0, 1, 2]).unwrap();
+        for x in [0.25, 1.0 / 3.0] {
+            let mut bytes = Vec::new();
+            write(&Nodes::new(&triangle(x), ElementOrder::Linear), &mut bytes).unwrap();
+            let back = read(path, &bytes).unwrap().finish::<2>(path).unwrap().0;
+            assert!((back.vertices()[2][0] - x).abs() <= 5e-11 * x, "{x}: {back:?}");
+            assert_eq!((back.cells(), &back.vertices()[..2]), (triangle(x).cells(), &triangle(x).vertices()[..2]));
+        }
     }
 
     /// Reads every console expert mesh shipped in shared/data (19 train + 2 val): positive
