@@ -28,13 +28,18 @@ use amber_train::{FinalStep, GeneratedStep, MeshMetrics, Reference, TrainError, 
 use anyhow::{Context, bail};
 use clap::Args;
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct MeshArgs {
     /// The geometry: `lshape` (with --corner), `square`, a polygon JSON
     /// `{"outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}`, a closed surface (.stl, .obj), a
     /// CAD file (.step, .stp, .iges, .igs, .brep; tessellated by gmsh, which must be installed), or
     /// a 2D or 3D mesh file whose boundary is the geometry. With --problem it may be left out: the
-    /// problem's own domain is meshed.
+    /// problem's own domain is meshed. Several geometries are meshed in turn, each to --output
+    /// with `{stem}` replaced by the geometry's file stem (`-o meshed/{stem}.msh`).
+    #[arg(num_args = 0..)]
+    geometries: Vec<String>,
+    /// The one geometry being meshed (set from `geometries`).
+    #[arg(skip)]
     geometry: Option<String>,
     /// Re-entrant corner of the `lshape` geometry.
     #[arg(long, value_parser = parse_point, default_value = "0.5,0.5")]
@@ -123,7 +128,58 @@ impl MeshArgs {
     }
 }
 
-pub fn run(args: MeshArgs) -> anyhow::Result<()> {
+pub fn run(mut args: MeshArgs) -> anyhow::Result<()> {
+    if args.geometries.len() > 1 {
+        return run_batch(&args);
+    }
+    args.geometry = args.geometries.pop();
+    if let (Some(geometry), Some(output)) = (&args.geometry, &args.output) {
+        args.output = Some(PathBuf::from(output.to_string_lossy().replace("{stem}", &part_name(geometry))));
+    }
+    run_one(args)
+}
+
+/// Several geometries, each meshed as alone to the output with `{stem}` replaced; a failure is
+/// reported and the rest are meshed, and the command fails if any did.
+fn run_batch(args: &MeshArgs) -> anyhow::Result<()> {
+    let template = args.output.as_deref().map(|o| o.to_string_lossy().into_owned()).unwrap_or_default();
+    if !template.contains("{stem}") {
+        bail!(
+            "with {} geometries, --output needs `{{stem}}` for each one's name (`-o meshed/{{stem}}.msh`)",
+            args.geometries.len()
+        );
+    }
+    let per_part = [
+        ("--expert", args.expert.is_some()),
+        ("--problem", args.problem.is_some()),
+        ("--every-step", args.every_step.is_some()),
+        ("--list-faces", args.list_faces),
+    ];
+    if let Some((flag, _)) = per_part.iter().find(|(_, given)| *given) {
+        bail!("{flag} belongs to one geometry: give one geometry with it");
+    }
+    let mut stems = BTreeSet::new();
+    if let Some(twice) = args.geometries.iter().map(|g| part_name(g)).find(|stem| !stems.insert(stem.clone())) {
+        bail!("two geometries have the stem `{twice}`: their meshes would overwrite each other");
+    }
+    let mut failed = Vec::new();
+    for geometry in &args.geometries {
+        let output = PathBuf::from(template.replace("{stem}", &part_name(geometry)));
+        eprintln!("{geometry} → {}", output.display());
+        let one =
+            MeshArgs { geometries: Vec::new(), geometry: Some(geometry.clone()), output: Some(output), ..args.clone() };
+        if let Err(e) = run_one(one) {
+            eprintln!("{geometry}: {e:#}");
+            failed.push(geometry.as_str());
+        }
+    }
+    if !failed.is_empty() {
+        bail!("{} of {} geometries failed: {}", failed.len(), args.geometries.len(), failed.join(", "));
+    }
+    Ok(())
+}
+
+fn run_one(args: MeshArgs) -> anyhow::Result<()> {
     // A format that cannot take the output fails now, not after the meshing.
     if let Some(output) = args.output.as_deref().filter(|o| o.extension().and_then(|e| e.to_str()) != Some("png")) {
         check_output(output, output_options(&args))?;

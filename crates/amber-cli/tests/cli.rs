@@ -103,6 +103,38 @@ fn meshes_a_solid_to_a_field_given_as_a_tet_mesh() {
     assert!(!output.status.success() && stderr.contains("flat.vtu"), "{stderr}");
 }
 
+/// Several geometries in one command: each meshed to the output with `{stem}` replaced; one
+/// that fails is named, the others are still written, and the command fails.
+#[test]
+fn meshes_several_geometries_in_one_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let template = dir.path().join("{stem}.vtu");
+    let output = amber().args(["mesh", "lshape", "square", "--size", "0.1", "-o"]).arg(&template).output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let lshape = amber_mesh::read_mesh::<2>(dir.path().join("lshape.vtu")).unwrap();
+    let square = amber_mesh::read_mesh::<2>(dir.path().join("square.vtu")).unwrap();
+    assert!((lshape.total_volume() - 0.75).abs() < 1e-12 && (square.total_volume() - 1.0).abs() < 1e-12);
+
+    let missing = dir.path().join("missing.stl");
+    let args = ["mesh", "lshape", missing.to_str().unwrap(), "--size", "0.1", "-o"];
+    let output = amber().args(args).arg(dir.path().join("again-{stem}.vtu")).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && stderr.contains("1 of 2 geometries failed") && stderr.contains("missing.stl"),
+        "{stderr}"
+    );
+    assert!(dir.path().join("again-lshape.vtu").exists());
+
+    for (args, needle) in [
+        (vec!["mesh", "lshape", "square", "--size", "0.1", "-o", "one.vtu"], "{stem}"),
+        (vec!["mesh", "a/part.stl", "b/part.stl", "--size", "0.1", "-o", "{stem}.vtu"], "the stem `part`"),
+    ] {
+        let output = amber().args(&args).current_dir(dir.path()).output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success() && stderr.contains(needle), "{args:?}: {stderr}");
+    }
+}
+
 #[test]
 fn converts_between_formats_in_the_dimension_of_the_file() {
     let dir = tempfile::tempdir().unwrap();
