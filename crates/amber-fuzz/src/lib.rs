@@ -107,7 +107,8 @@ pub fn polygon_domain(data: &[u8]) {
 
 /// Every writer, in both element orders, on a mesh a reader accepted, with the fields and facet
 /// tags it read: a refusal names the file, and a written file reads back as the same mesh (the
-/// corners of a second-order one, each element counted as linearised).
+/// corners of a second-order one, each element counted as linearised; NASTRAN's coordinates to
+/// the 16 characters of a large field).
 fn assert_written_back<const D: usize>(mesh: &Mesh<D>, data: &MeshData) {
     let dir = scratch_dir();
     for extension in MESH_EXTENSIONS {
@@ -120,7 +121,20 @@ fn assert_written_back<const D: usize>(mesh: &Mesh<D>, data: &MeshData) {
             }
             let (back, back_data) =
                 read_mesh_with_data::<D>(&path).unwrap_or_else(|e| panic!("{extension} {order:?}: {e}"));
-            assert!(&back == mesh, "{extension} {order:?}: read back as another mesh");
+            let same = if extension == "nas" {
+                // 5e-11 relative where the exponent has one or two digits, 5e-9 with three.
+                let close = |a: f64, b: f64| (a - b).abs() <= 5e-9 * a.abs();
+                back.cells() == mesh.cells()
+                    && back
+                        .vertices()
+                        .iter()
+                        .flatten()
+                        .zip(mesh.vertices().iter().flatten())
+                        .all(|(&a, &b)| close(a, b))
+            } else {
+                &back == mesh
+            };
+            assert!(same, "{extension} {order:?}: read back as another mesh");
             if order == ElementOrder::Quadratic {
                 assert_eq!(back_data.linearised.values().sum::<usize>(), mesh.num_elements(), "{extension}");
             }
