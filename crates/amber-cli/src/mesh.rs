@@ -524,7 +524,8 @@ fn output_options(args: &MeshArgs) -> WriteOptions {
 fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
     let geometry = args.geometry.as_deref().unwrap_or("lshape");
     let start = Instant::now();
-    let (elements, report) = if is_solid(geometry) {
+    let solid = is_solid(geometry);
+    let (elements, report) = if solid {
         match size.parse::<f64>() {
             Ok(h) => mesh_solid_with(args, geometry, &ConstantSize(h), h).map(|(m, r)| (m.num_elements(), r))?,
             Err(_) => {
@@ -550,12 +551,12 @@ fn with_size(args: &MeshArgs, size: &str) -> anyhow::Result<()> {
     };
     eprintln!(
         "{elements} {} in {:.3} s; size ratio median {:.3} (p10 {:.3}, p90 {:.3}); mean smallest {} {:.1}°; wrote {}",
-        if is_solid(geometry) { "tetrahedra" } else { "triangles" },
+        if solid { "tetrahedra" } else { "triangles" },
         start.elapsed().as_secs_f64(),
         report.size_ratio_median,
         report.size_ratio_p10,
         report.size_ratio_p90,
-        if is_solid(geometry) { "dihedral angle" } else { "angle" },
+        if solid { "dihedral angle" } else { "angle" },
         report.mean_min_angle,
         args.output().display()
     );
