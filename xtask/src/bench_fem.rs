@@ -63,7 +63,7 @@ struct ExpertCase {
 struct SolveCase {
     triangles: usize,
     dofs: usize,
-    nnz_lower: usize,
+    nnz_upper: usize,
     /// Median wall times on `threads` threads.
     assemble_seconds: f64,
     solve_seconds: f64,
@@ -150,7 +150,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let case = SolveCase {
             triangles: mesh.num_elements(),
             dofs: stiffness.dofs(),
-            nnz_lower: stiffness.nnz_lower(),
+            nnz_upper: stiffness.nnz_upper(),
             assemble_seconds,
             solve_seconds,
             single_thread_assemble_seconds,

@@ -25,6 +25,7 @@ mod error;
 mod estimator;
 mod expert;
 mod load;
+mod ordering;
 mod poisson;
 mod quadrature;
 mod space;

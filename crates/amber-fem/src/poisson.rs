@@ -2,15 +2,17 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{CholeskySymbolicParams, SymmetricOrdering, factorize_symbolic_cholesky};
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
 
-use crate::space::NO_DOF;
+use crate::space::{NO_DOF, parallel_lists};
 use crate::{FemError, Load, P1Space, Quadrature};
 
-/// The lower triangle (diagonal included) of the symmetric stiffness matrix on the degrees of
+/// The upper triangle (diagonal included) of the symmetric stiffness matrix on the degrees of
 /// freedom, in compressed sparse column form with sorted rows.
 #[derive(Clone, Debug)]
 pub struct StiffnessMatrix {
@@ -18,6 +20,16 @@ pub struct StiffnessMatrix {
     col_ptr: Vec<u32>,
     row_idx: Vec<u32>,
     values: Vec<f64>,
+    ordering: Elimination,
+}
+
+/// The order in which the Cholesky factorisation eliminates the degrees of freedom.
+#[derive(Clone, Copy, Debug)]
+enum Elimination {
+    /// Approximate minimum degree (faer's).
+    Amd,
+    /// Their numbering: the space numbered them in nested-dissection order.
+    AsNumbered,
 }
 
 /// The load f at every quadrature point of every element: the load vector and the error
@@ -54,62 +66,36 @@ pub struct PoissonSolution {
 impl<const D: usize> P1Space<'_, D> {
     /// Assembles K_ij = ∫ ∇φ_i·∇φ_j over the degrees of freedom.
     ///
-    /// Element matrices are computed in parallel; their entries are then bucketed by column
-    /// (counting sort) and each column's few rows sorted stably, so the sums run in element order
-    /// whatever the thread count.
+    /// Columns are assembled in parallel, each from the elements around its vertex; every entry
+    /// sums its elements' contributions in element order, so the matrix is the same whatever the
+    /// thread count.
     pub fn stiffness(&self) -> StiffnessMatrix {
-        let pairs: Vec<(usize, usize)> = (0..=D).flat_map(|i| (i..=D).map(move |j| (i, j))).collect();
-        let local: Vec<[f64; 10]> = self
-            .geometry
-            .par_iter()
-            .map(|g| {
-                let mut k = [0.0; 10];
-                for (slot, &(i, j)) in pairs.iter().enumerate() {
-                    k[slot] = g.volume * (0..D).map(|d| g.grads[i][d] * g.grads[j][d]).sum::<f64>();
+        let (col_ptr, column_entries) = parallel_lists(&self.vertex_of, |c, v, column: &mut Vec<(u32, f64)>| {
+            let c = c as u32;
+            let first = column.len();
+            for &e in &self.around[self.around_start[v as usize] as usize..self.around_start[v as usize + 1] as usize] {
+                let cell = self.mesh.element(e as usize);
+                let g = &self.geometry[e as usize];
+                let a = cell.iter().position(|&w| w == v).expect("the element is around its vertex");
+                for (b, &w) in cell.iter().enumerate() {
+                    let row = self.dof[w as usize];
+                    // Column c holds the rows r ≤ c of the upper triangle.
+                    if row == NO_DOF || row > c {
+                        continue;
+                    }
+                    let (i, j) = (a.min(b), a.max(b));
+                    let k_ij = g.volume * (0..D).map(|d| g.grads[i][d] * g.grads[j][d]).sum::<f64>();
+                    match column[first..].iter_mut().find(|(r, _)| *r == row) {
+                        Some((_, sum)) => *sum += k_ij,
+                        None => column.push((row, k_ij)),
+                    }
                 }
-                k
-            })
-            .collect();
-        // (column, row, slot) of the element's entries that couple two degrees of freedom.
-        let entries = |e: usize| {
-            let cell = self.mesh.element(e);
-            pairs.iter().enumerate().filter_map(move |(slot, &(i, j))| {
-                let (a, b) = (self.dof[cell[i] as usize], self.dof[cell[j] as usize]);
-                (a != NO_DOF && b != NO_DOF).then(|| (a.min(b) as usize, a.max(b), slot))
-            })
-        };
-        let n = self.num_dofs;
-        let mut offsets = vec![0usize; n + 1];
-        for e in 0..self.mesh.num_elements() {
-            for (col, _, _) in entries(e) {
-                offsets[col + 1] += 1;
             }
-        }
-        for c in 0..n {
-            offsets[c + 1] += offsets[c];
-        }
-        let mut fill = offsets.clone();
-        let mut bucket = vec![(0u32, 0.0f64); offsets[n]];
-        for (e, k) in local.iter().enumerate() {
-            for (col, row, slot) in entries(e) {
-                bucket[fill[col]] = (row, k[slot]);
-                fill[col] += 1;
-            }
-        }
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::with_capacity(offsets[n] / 2 + 1);
-        let mut values = Vec::with_capacity(offsets[n] / 2 + 1);
-        col_ptr.push(0u32);
-        for c in 0..n {
-            let column = &mut bucket[offsets[c]..offsets[c + 1]];
-            column.sort_by_key(|&(row, _)| row);
-            for group in column.chunk_by(|x, y| x.0 == y.0) {
-                row_idx.push(group[0].0);
-                values.push(group.iter().map(|&(_, v)| v).sum());
-            }
-            col_ptr.push(row_idx.len() as u32);
-        }
-        StiffnessMatrix { dofs: n, col_ptr, row_idx, values }
+            column[first..].sort_unstable_by_key(|&(row, _)| row);
+        });
+        let (row_idx, values) = column_entries.into_iter().unzip();
+        let ordering = if self.dissected { Elimination::AsNumbered } else { Elimination::Amd };
+        StiffnessMatrix { dofs: self.num_dofs, col_ptr, row_idx, values, ordering }
     }
 
     /// Evaluates f at the points of `quadrature` in every element (the reference uses degree 2).
@@ -177,13 +163,13 @@ impl StiffnessMatrix {
         self.dofs
     }
 
-    /// Stored entries of the lower triangle.
-    pub fn nnz_lower(&self) -> usize {
+    /// Stored entries of the upper triangle.
+    pub fn nnz_upper(&self) -> usize {
         self.values.len()
     }
 
-    /// Solves K x = rhs by sparse Cholesky (faer, AMD ordering, sequential: callers parallelise
-    /// across problems).
+    /// Solves K x = rhs by sparse Cholesky (faer; nested dissection or AMD ordering; sequential:
+    /// callers parallelise across problems, and faer's parallel factorisation was slower here).
     pub fn solve(&self, rhs: &[f64]) -> Result<Vec<f64>, FemError> {
         let n = self.dofs;
         let mut x = rhs.to_vec();
@@ -192,14 +178,8 @@ impl StiffnessMatrix {
         }
         let failed = |message: String| FemError::Factorisation { dofs: n, message };
         let par = Par::Seq;
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
-        let symbolic = factorize_symbolic_cholesky(
-            pattern,
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| failed(format!("{e:?}")))?;
+        let pattern = self.pattern();
+        let symbolic = self.symbolic()?;
         let mut factor = vec![0.0; symbolic.len_val()];
         let mut buffer = MemBuffer::try_new(StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
@@ -211,7 +191,7 @@ impl StiffnessMatrix {
             .factorize_numeric_llt(
                 &mut factor,
                 SparseColMatRef::new(pattern, &self.values),
-                Side::Lower,
+                Side::Upper,
                 LltRegularization::default(),
                 par,
                 stack,
@@ -222,7 +202,21 @@ impl StiffnessMatrix {
         Ok(x)
     }
 
-    /// y = K x, using the symmetry of the stored lower triangle.
+    fn pattern(&self) -> SymbolicSparseColMatRef<'_, u32> {
+        SymbolicSparseColMatRef::new_checked(self.dofs, self.dofs, &self.col_ptr, None, &self.row_idx)
+    }
+
+    /// The factor's structure (its elimination order and fill).
+    fn symbolic(&self) -> Result<SymbolicCholesky<u32>, FemError> {
+        let ordering = match self.ordering {
+            Elimination::Amd => SymmetricOrdering::Amd,
+            Elimination::AsNumbered => SymmetricOrdering::Identity,
+        };
+        factorize_symbolic_cholesky(self.pattern(), Side::Upper, ordering, CholeskySymbolicParams::default())
+            .map_err(|e| FemError::Factorisation { dofs: self.dofs, message: format!("{e:?}") })
+    }
+
+    /// y = K x, using the symmetry of the stored upper triangle.
     pub fn apply(&self, x: &[f64]) -> Vec<f64> {
         let mut y = vec![0.0; self.dofs];
         for col in 0..self.dofs {
@@ -248,6 +242,7 @@ impl StiffnessMatrix {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::space::NESTED_DISSECTION_MIN_DOFS;
     use amber_mesh::{Mesh2, Mesh3};
     use std::f64::consts::PI;
 
@@ -309,6 +304,57 @@ mod tests {
         let ones = k.apply(&[1.0; 9]);
         // Row sums: 4 − (number of interior neighbours).
         assert_eq!(ones, vec![2.0, 1.0, 2.0, 1.0, 0.0, 1.0, 2.0, 1.0, 2.0]);
+    }
+
+    #[test]
+    fn entries_sum_their_elements_in_element_order() {
+        // The same sums, bit for bit, as adding each element's entries in element order.
+        let mut mesh = grid(9);
+        let jiggle = |p: [f64; 2]| [p[0] + 0.013 * (7.0 * p[1]).sin(), p[1] + 0.011 * (5.0 * p[0]).cos()];
+        mesh = Mesh2::new(mesh.vertices().iter().map(|&p| jiggle(p)).collect(), mesh.cells().to_vec()).unwrap();
+        let space = P1Space::new(&mesh).unwrap();
+        let mut expected = std::collections::BTreeMap::new();
+        for (e, cell) in mesh.elements().enumerate() {
+            let g = &space.geometry()[e];
+            for i in 0..3 {
+                for j in i..3 {
+                    let (a, b) = (space.dof[cell[i] as usize], space.dof[cell[j] as usize]);
+                    if a != NO_DOF && b != NO_DOF {
+                        let value = g.volume * (0..2).map(|d| g.grads[i][d] * g.grads[j][d]).sum::<f64>();
+                        *expected.entry((a.max(b), a.min(b))).or_insert(-0.0) += value;
+                    }
+                }
+            }
+        }
+        let k = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap().install(|| space.stiffness());
+        let mut got = Vec::new();
+        for col in 0..k.dofs() {
+            for at in k.col_ptr[col] as usize..k.col_ptr[col + 1] as usize {
+                got.push(((col as u32, k.row_idx[at]), k.values[at].to_bits()));
+            }
+        }
+        let expected: Vec<_> = expected.into_iter().map(|(key, v)| (key, v.to_bits())).collect();
+        assert_eq!(got, expected);
+    }
+
+    #[test]
+    fn large_systems_solve_in_nested_dissection_order() {
+        let mesh = grid(320);
+        let space = P1Space::new(&mesh).unwrap();
+        let q = Quadrature::simplex::<2>(2).unwrap();
+        let rhs = space.load_vector(&space.sample_load(&|p: [f64; 2]| 1.0 + p[0] * p[1], &q).unwrap());
+        let k = space.stiffness();
+        assert!(k.dofs() >= NESTED_DISSECTION_MIN_DOFS && matches!(k.ordering, Elimination::AsNumbered));
+        let x = k.solve(&rhs).unwrap();
+        assert!(k.relative_residual(&x, &rhs) < 1e-10);
+        let amd_ordered = StiffnessMatrix { ordering: Elimination::Amd, ..k.clone() };
+        // The nested-dissection numbering leaves less fill than AMD at this size.
+        let (fill, amd_fill) = (k.symbolic().unwrap().len_val(), amd_ordered.symbolic().unwrap().len_val());
+        assert!(fill < amd_fill, "{fill} entries in the factor against AMD's {amd_fill}");
+        let amd = amd_ordered.solve(&rhs).unwrap();
+        let scale = amd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let gap = x.iter().zip(&amd).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(gap < 1e-10 * scale, "{gap} against {scale}");
     }
 
     #[test]

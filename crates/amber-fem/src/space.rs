@@ -5,6 +5,7 @@ use amber_mesh::{FacetAdjacency, Mesh};
 use rayon::prelude::*;
 
 use crate::FemError;
+use crate::ordering::nested_dissection;
 
 /// Geometry of one simplex: its volume and the gradients of its barycentric coordinates (the P1
 /// shape functions), `grads[i]` for local vertex `i ≤ D`.
@@ -63,6 +64,13 @@ impl<const D: usize> ElementGeometry<D> {
 /// Marker for a vertex without a degree of freedom (on the Dirichlet boundary).
 pub(crate) const NO_DOF: u32 = u32::MAX;
 
+/// From this many degrees of freedom on, they are numbered in nested-dissection order, which
+/// leaves less fill than AMD on mesh graphs and costs less to compute (docs/PROFILES.md).
+pub(crate) const NESTED_DISSECTION_MIN_DOFS: usize = 100_000;
+
+/// Vertices (or columns) handled by one parallel task.
+const VERTICES_PER_TASK: usize = 4096;
+
 /// P1 Lagrange elements on `mesh` with u = 0 on the whole boundary.
 pub struct P1Space<'m, const D: usize> {
     pub(crate) mesh: &'m Mesh<D>,
@@ -70,29 +78,66 @@ pub struct P1Space<'m, const D: usize> {
     pub(crate) geometry: Vec<ElementGeometry<D>>,
     /// Degree of freedom of each vertex, or [`NO_DOF`] on the boundary.
     pub(crate) dof: Vec<u32>,
+    /// The vertex of each degree of freedom.
+    pub(crate) vertex_of: Vec<u32>,
     pub(crate) num_dofs: usize,
+    /// Whether the degrees of freedom are numbered in nested-dissection order (large meshes).
+    pub(crate) dissected: bool,
+    /// The elements around each vertex, in element order: `around[around_start[v]..around_start[v + 1]]`.
+    pub(crate) around_start: Vec<u32>,
+    pub(crate) around: Vec<u32>,
 }
 
 impl<'m, const D: usize> P1Space<'m, D> {
     /// Builds the space: adjacency (fails on a non-conforming mesh), element geometry, and one
-    /// degree of freedom per interior vertex, numbered in vertex order.
+    /// degree of freedom per interior vertex, numbered in vertex order, or in nested-dissection
+    /// order from [`NESTED_DISSECTION_MIN_DOFS`] on (the sparse factorisation keeps it).
     pub fn new(mesh: &'m Mesh<D>) -> Result<Self, FemError> {
         let adjacency = FacetAdjacency::new(mesh)?;
         let boundary = adjacency.boundary_vertices(mesh);
-        let mut num_dofs = 0;
-        let dof = boundary
-            .iter()
-            .map(|&b| {
-                if b {
-                    NO_DOF
-                } else {
-                    num_dofs += 1;
-                    (num_dofs - 1) as u32
+        let mut around_start = vec![0u32; mesh.num_vertices() + 1];
+        for &v in mesh.cells() {
+            around_start[v as usize + 1] += 1;
+        }
+        for v in 0..mesh.num_vertices() {
+            around_start[v + 1] += around_start[v];
+        }
+        let mut fill = around_start.clone();
+        let mut around = vec![0u32; mesh.cells().len()];
+        for (e, cell) in mesh.elements().enumerate() {
+            for &v in cell {
+                around[fill[v as usize] as usize] = e as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        let mut vertex_of: Vec<u32> = (0..mesh.num_vertices() as u32).filter(|&v| !boundary[v as usize]).collect();
+        let mut dof = vec![NO_DOF; mesh.num_vertices()];
+        for (d, &v) in vertex_of.iter().enumerate() {
+            dof[v as usize] = d as u32;
+        }
+        let num_dofs = vertex_of.len();
+        let dissected = num_dofs >= NESTED_DISSECTION_MIN_DOFS;
+        if dissected {
+            let (neighbours_start, neighbours) = parallel_lists(&vertex_of, |_, v, out| {
+                let first = out.len();
+                for &e in &around[around_start[v as usize] as usize..around_start[v as usize + 1] as usize] {
+                    for &w in mesh.element(e as usize) {
+                        let d = dof[w as usize];
+                        if w != v && d != NO_DOF && !out[first..].contains(&d) {
+                            out.push(d);
+                        }
+                    }
                 }
-            })
-            .collect();
+            });
+            let points: Vec<[f64; D]> = vertex_of.iter().map(|&v| mesh.vertices()[v as usize]).collect();
+            let order = nested_dissection(&points, &neighbours_start, &neighbours);
+            vertex_of = order.iter().map(|&d| vertex_of[d as usize]).collect();
+            for (d, &v) in vertex_of.iter().enumerate() {
+                dof[v as usize] = d as u32;
+            }
+        }
         let geometry = (0..mesh.num_elements()).into_par_iter().map(|e| ElementGeometry::new(mesh, e)).collect();
-        Ok(Self { mesh, adjacency, geometry, dof, num_dofs })
+        Ok(Self { mesh, adjacency, geometry, dof, vertex_of, num_dofs, dissected, around_start, around })
     }
 
     /// The mesh.
@@ -131,6 +176,37 @@ impl<'m, const D: usize> P1Space<'m, D> {
             Err(FemError::SolutionLength { len: u.len(), num_vertices: self.mesh.num_vertices() })
         }
     }
+}
+
+/// Compressed lists, one per item, built in parallel: `list(i, item, out)` appends item i's
+/// entries to `out` (which holds earlier items' entries before them). Returns (start, entries), list i at `entries[start[i]..start[i + 1]]`.
+pub(crate) fn parallel_lists<T: Send>(
+    items: &[u32],
+    list: impl Fn(usize, u32, &mut Vec<T>) + Sync,
+) -> (Vec<u32>, Vec<T>) {
+    let chunks: Vec<(Vec<u32>, Vec<T>)> = items
+        .par_chunks(VERTICES_PER_TASK)
+        .enumerate()
+        .map(|(chunk, items)| {
+            let (mut lengths, mut entries) = (Vec::with_capacity(items.len()), Vec::new());
+            for (k, &item) in items.iter().enumerate() {
+                let before = entries.len();
+                list(chunk * VERTICES_PER_TASK + k, item, &mut entries);
+                lengths.push((entries.len() - before) as u32);
+            }
+            (lengths, entries)
+        })
+        .collect();
+    let mut start = Vec::with_capacity(items.len() + 1);
+    start.push(0u32);
+    let mut all = Vec::with_capacity(chunks.iter().map(|(_, e)| e.len()).sum());
+    for (lengths, entries) in chunks {
+        for length in lengths {
+            start.push(start.last().copied().unwrap_or(0) + length);
+        }
+        all.extend(entries);
+    }
+    (start, all)
 }
 
 /// Mean and population standard deviation of a vertex function over one element's vertices.

@@ -16,25 +16,41 @@ impl FacetAdjacency {
     /// Marker for a facet on the boundary.
     pub const BOUNDARY: u32 = u32::MAX;
 
-    /// Builds the adjacency by sorting facet keys (O(n log n), deterministic).
+    /// Builds the adjacency by sorting facet keys (deterministic): bucketed by their smallest
+    /// vertex (a counting sort), then each vertex's few facets sorted.
     ///
     /// Fails if a facet is shared by more than two elements, or by two that lie on the same side
     /// of it (overlapping elements, such as a listed twice): a conforming mesh has neither.
     pub fn new<const D: usize>(mesh: &Mesh<D>) -> Result<Self, MeshError> {
         let n = D + 1;
         // (sorted vertices, whether sorting the outward listing took an odd permutation, slot).
-        let mut facets: Vec<([u32; 3], bool, u32)> = Vec::with_capacity(mesh.cells().len());
-        for (e, cell) in mesh.elements().enumerate() {
-            for (i, local) in outward_facets::<D>().iter().enumerate() {
-                let mut key = [u32::MAX; 3];
-                for (k, &j) in local.iter().enumerate() {
-                    key[k] = cell[j];
-                }
-                let odd = sort_parity(&mut key[..D]);
-                facets.push((key, odd, (e * n + i) as u32));
+        let key_of = |slot: usize| {
+            let (cell, local) = (mesh.element(slot / n), outward_facets::<D>()[slot % n]);
+            let mut key = [u32::MAX; 3];
+            for (k, &j) in local.iter().enumerate() {
+                key[k] = cell[j];
             }
+            let odd = sort_parity(&mut key[..D]);
+            (key, odd, slot as u32)
+        };
+        let slots = mesh.cells().len();
+        let mut start = vec![0u32; mesh.num_vertices() + 1];
+        for slot in 0..slots {
+            start[key_of(slot).0[0] as usize + 1] += 1;
         }
-        facets.sort_unstable();
+        for v in 0..mesh.num_vertices() {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut facets = vec![([0u32; 3], false, 0u32); slots];
+        for slot in 0..slots {
+            let facet = key_of(slot);
+            facets[fill[facet.0[0] as usize] as usize] = facet;
+            fill[facet.0[0] as usize] += 1;
+        }
+        for v in 0..mesh.num_vertices() {
+            facets[start[v] as usize..start[v + 1] as usize].sort_unstable();
+        }
         let mut neighbours = vec![Self::BOUNDARY; facets.len()];
         let mut i = 0;
         while i < facets.len() {
