@@ -86,30 +86,35 @@ fn z_order<const K: usize>(points: &[[f64; K]]) -> Vec<[f64; K]> {
     }
     let cells = ((1u64 << bits) - 1) as f64;
     let scale: [f64; K] = std::array::from_fn(|k| if hi[k] > lo[k] { cells / (hi[k] - lo[k]) } else { 0.0 });
-    let mut keyed: Vec<(u64, u32)> = points
-        .par_iter()
-        .enumerate()
-        .map(|(index, p)| {
-            let cell: [u64; K] = std::array::from_fn(|k| ((p[k] - lo[k]) * scale[k]) as u64);
-            let mut code = 0u64;
-            for b in (0..bits).rev() {
-                for c in cell {
-                    code = (code << 1) | ((c >> b) & 1);
-                }
+    let code = |p: &[f64; K]| {
+        let cell: [u64; K] = std::array::from_fn(|k| ((p[k] - lo[k]) * scale[k]) as u64);
+        let mut code = 0u64;
+        for b in (0..bits).rev() {
+            for c in cell {
+                code = (code << 1) | ((c >> b) & 1);
             }
-            (code, index as u32)
-        })
-        .collect();
-    // A radix sort of (code, index) pairs moves a third of the bytes a sort of the points would
-    // and is ~5× faster than a comparison sort; it keeps the input order within a cell, so
-    // cells holding several points are then ordered by coordinates.
+        }
+        code
+    };
     if K * bits <= 32 {
-        // The same order from half the radix passes: the codes' upper half is zero.
-        radsort::sort_by_key(&mut keyed, |&(code, _)| code as u32);
+        // The same order from half the bytes and radix passes: the codes' upper half is zero.
+        sorted_by_code(points, |p| code(p) as u32)
     } else {
-        radsort::sort_by_key(&mut keyed, |&(code, _)| code);
+        sorted_by_code(points, code)
     }
-    let coordinates = |(_, index): &(u64, u32)| &points[*index as usize];
+}
+
+/// `points` sorted by `code`, ties by their coordinates.
+fn sorted_by_code<const K: usize, C>(points: &[[f64; K]], code: impl Fn(&[f64; K]) -> C + Sync) -> Vec<[f64; K]>
+where
+    C: radsort::Key + PartialEq + Send,
+{
+    let mut keyed: Vec<(C, u32)> = points.par_iter().enumerate().map(|(index, p)| (code(p), index as u32)).collect();
+    // A radix sort of (code, index) pairs moves a fraction of the bytes a sort of the points
+    // would and is ~5× faster than a comparison sort; it keeps the input order within a cell, so
+    // cells holding several points are then ordered by coordinates.
+    radsort::sort_by_key(&mut keyed, |&(code, _)| code);
+    let coordinates = |(_, index): &(C, u32)| &points[*index as usize];
     for cell in keyed.chunk_by_mut(|a, b| a.0 == b.0).filter(|cell| cell.len() > 1) {
         cell.sort_unstable_by(|a, b| {
             let (pa, pb) = (coordinates(a), coordinates(b));
@@ -132,22 +137,24 @@ fn one_direction<const K: usize>(
 ) -> Result<DirectionMeans, MetricsError> {
     let tree: ImmutableKdTree<f64, K> = ImmutableKdTree::new_from_slice(targets)
         .map_err(|source| MetricsError::KdTree { which: targets_name, source })?;
-    let nearest: Vec<(u32, f64)> = queries
+    // (nearest target, distance, e^{−distance}).
+    let nearest: Vec<(u32, f64, f64)> = queries
         .par_iter()
         .with_min_len(4096)
         .map(|q| {
             let nn = tree.query(q).nearest_one::<SquaredEuclidean<f64>>().execute();
-            (nn.item, nn.distance.sqrt())
+            let distance = nn.distance.sqrt();
+            (nn.item, distance, (-distance).exp())
         })
         .collect();
     let mut hits = vec![0u32; targets.len()];
-    for &(t, _) in &nearest {
+    for &(t, _, _) in &nearest {
         hits[t as usize] += 1;
     }
     // Sequential sums keep the result independent of the thread count.
     let (mut density_aware, mut distance) = (0.0, 0.0);
-    for &(t, d) in &nearest {
-        density_aware += 1.0 - (-d).exp() / f64::from(hits[t as usize]);
+    for &(t, d, decay) in &nearest {
+        density_aware += 1.0 - decay / f64::from(hits[t as usize]);
         distance += d;
     }
     let n = queries.len() as f64;
