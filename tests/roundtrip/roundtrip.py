@@ -284,6 +284,11 @@ def read_with_meshio(path, dim, points, cells, size, has_data, physical):
         same_size_field(m, SIMPLEX[dim], size)
     if physical and not {"domain", "boundary"} <= set(m.field_data):
         raise AssertionError(f"physical names {sorted(m.field_data)}")
+    if path.endswith(".nas") and dim == 3:
+        # The boundary as skin triangles (amber keeps the point order), each facet once.
+        skin = sorted(tuple(sorted(t)) for c in m.cells if c.type == "triangle" for t in c.data.tolist())
+        if skin != sorted(boundary_facets(cells, dim)):
+            raise AssertionError(f"{len(skin)} skin triangles, not the {len(boundary_facets(cells, dim))} boundary facets")
     if path.endswith(".inp"):
         boundary = sorted({v for f in boundary_facets(cells, dim) for v in f})
         if "boundary" not in m.point_sets:

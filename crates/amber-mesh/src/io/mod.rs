@@ -36,7 +36,8 @@ use crate::{Mesh, Mesh2, Mesh3, MeshError};
 /// or per vertex (`point`), tags on boundary facets, and what a reader left out.
 ///
 /// `.vtu`, `.vtk`, `.msh` and `.json` store the fields; `.nas`, `.inp` and `.mesh` none. `.msh`
-/// and `.mesh` store the facet tags; `.inp` writes them as node sets and element-side surfaces.
+/// and `.mesh` store the facet tags; `.inp` writes them as node sets and element-side surfaces,
+/// and `.nas` (3D) as skin triangles under one property per tag.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {
     /// Per-element fields, by name.
@@ -355,7 +356,7 @@ pub fn write_mesh_as<const D: usize>(
         Format::Vtk => write_atomic(path, |w| vtk::write(&nodes, data, binary, w, path)),
         Format::Msh => write_atomic(path, |w| msh::write(&nodes, data, binary, w, path)),
         Format::Json => write_atomic(path, |w| json::write(mesh, data, w, path)),
-        Format::Nastran => write_atomic(path, |w| nastran::write(&nodes, w).map_err(write_error(path))),
+        Format::Nastran => write_atomic(path, |w| nastran::write(&nodes, data, w, path)),
         Format::Abaqus => write_atomic(path, |w| abaqus::write(&nodes, data, w, path)),
         Format::Medit => write_atomic(path, |w| medit::write(mesh, data, w, path)),
     }

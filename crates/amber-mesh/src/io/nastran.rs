@@ -6,10 +6,19 @@
 //! there: a file without it is truncated, and a partial mesh is never returned. Reals may use
 //! NASTRAN's implicit exponent (`-7.11-15` = -7.11e-15). GRID ids may have gaps.
 //!
+//! An element's property id (PID) is its tag: in a tet mesh, the CTRIA3 (CTRIA6) skin
+//! triangles become facet tags by their PID, as the physical groups of a `.msh` do.
+//!
 //! The writer writes free-field cards (GRID, CTETRA or CTRIA3; second order: CTETRA with its six
 //! edge grids, four of them on a `+` continuation line, or CTRIA6) with coordinates in their
 //! shortest round-trip form where it fits a large field (16 characters), so such a mesh reads
 //! back bit-exactly, and else to 5e-11 relative (a coordinate's exponent of one or two digits).
+//! The model is laid out as the Console experts' ANSA files are: a tet mesh's CTETRA under one
+//! PSOLID, and its boundary as CTRIA3 (CTRIA6) skin triangles, outward, one PSHELL per facet tag
+//! (PID = tag; the untagged boundary one past the largest tag), the solid's PID one past those.
+//! The skin's PSHELLs name no material, so in MSC Nastran they add no stiffness: they carry the
+//! faces' groups for loads and constraints. The PSOLID (and a triangle mesh's PSHELL, thickness
+//! 1) reference material 1, which the file does not define: the user's solver deck does.
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -17,7 +26,7 @@ use std::path::Path;
 
 use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
-use super::{Lines, MeshError};
+use super::{Lines, MeshData, MeshError, tagged_facets, write_error, writer_adjacency};
 
 /// The kind of an element card (a CTETRA with edge grids is found by its fields).
 fn element_card(card: &str) -> Option<Kind> {
@@ -39,8 +48,9 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut lines = Lines::new(path, bytes);
     let mut grid_index: HashMap<u64, u32> = HashMap::new();
     let mut raw = RawMesh::default();
-    // Element grid ids with their line, resolved once every GRID is known (cards may come in any order).
-    let mut elements: Vec<(Kind, Vec<u64>, usize)> = Vec::new();
+    // Element grid ids with their PID and line, resolved once every GRID is known (cards may come
+    // in any order).
+    let mut elements: Vec<(Kind, Vec<u64>, i32, usize)> = Vec::new();
     let mut complete = false;
     while let Some(line) = lines.next()? {
         if line.starts_with('$') || line.trim().is_empty() {
@@ -92,12 +102,14 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                     } else {
                         Vec::new()
                     };
-                    elements.push((kind, ids, lines.line));
+                    // A PID that is no positive integer tags nothing.
+                    let pid = fields.get(2).trim().parse::<i32>().ok().filter(|&p| p > 0).unwrap_or(0);
+                    elements.push((kind, ids, pid, lines.line));
                 }
             }
         }
     }
-    for (kind, ids, line) in elements {
+    for (kind, ids, pid, line) in elements {
         let nodes = ids.iter().map(|id| {
             grid_index.get(id).copied().ok_or_else(|| MeshError::Parse {
                 path: path.to_owned(),
@@ -106,6 +118,7 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
             })
         });
         raw.push_cell(kind, nodes.collect::<Result<Vec<u32>, _>>()?);
+        raw.tags.push(pid);
     }
     if !complete {
         let message = format!("no ENDDATA after line {}: the file is truncated", lines.line);
@@ -114,27 +127,66 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     Ok(raw)
 }
 
-pub(super) fn write<const D: usize>(nodes: &Nodes<D>, w: &mut impl Write) -> std::io::Result<()> {
+pub(super) fn write<const D: usize>(
+    nodes: &Nodes<D>,
+    data: &MeshData,
+    w: &mut impl Write,
+    path: &Path,
+) -> Result<(), MeshError> {
+    let mesh = nodes.mesh();
+    let skin = if D == 3 { tagged_facets(mesh, &writer_adjacency(mesh, path)?, data, path)? } else { Vec::new() };
+    if let Some((_, tag)) = skin.iter().find(|(_, t)| *t <= 0) {
+        let message = format!("facet tag {tag}: NASTRAN property ids need positive tags");
+        return Err(MeshError::Format { path: path.to_owned(), message });
+    }
+    let solid = skin.iter().map(|&(_, t)| t).max().map_or(1, |t| t.saturating_add(1));
+    write_body(nodes, &skin, solid, w).map_err(write_error(path))
+}
+
+fn write_body<const D: usize>(
+    nodes: &Nodes<D>,
+    skin: &[(Vec<u32>, i32)],
+    solid: i32,
+    w: &mut impl Write,
+) -> std::io::Result<()> {
     writeln!(w, "$ written by amber\nBEGIN BULK")?;
     for (i, p) in nodes.points().enumerate() {
         let [x, y, z] = [p[0], p[1], if D == 3 { p[2] } else { 0.0 }].map(large_field_real);
         writeln!(w, "GRID,{},,{x},{y},{z}", i + 1)?;
     }
-    let card = match (D, nodes.is_quadratic()) {
-        (2, false) => "CTRIA3",
-        (2, true) => "CTRIA6",
-        _ => "CTETRA",
+    let (card, facet_card) = match (D, nodes.is_quadratic()) {
+        (2, false) => ("CTRIA3", ""),
+        (2, true) => ("CTRIA6", ""),
+        (_, false) => ("CTETRA", "CTRIA3"),
+        (_, true) => ("CTETRA", "CTRIA6"),
     };
-    for (e, cell) in nodes.elements().enumerate() {
-        write!(w, "{card},{},1", e + 1)?;
-        for (k, v) in cell.iter().enumerate() {
+    let mut write_element = |card: &str, id: usize, pid: i32, grids: &[u32]| {
+        write!(w, "{card},{id},{pid}")?;
+        for (k, v) in grids.iter().enumerate() {
             // A free-field card holds eight fields after its name; a 10-node CTETRA continues.
             if k == 6 {
                 write!(w, ",+\n+")?;
             }
             write!(w, ",{}", v + 1)?;
         }
-        writeln!(w)?;
+        writeln!(w)
+    };
+    let elements = nodes.mesh().num_elements();
+    for (e, cell) in nodes.elements().enumerate() {
+        write_element(card, e + 1, solid, &cell)?;
+    }
+    for (k, (facet, tag)) in skin.iter().enumerate() {
+        write_element(facet_card, elements + k + 1, *tag, &nodes.facet(facet))?;
+    }
+    if D == 3 {
+        writeln!(w, "PSOLID,{solid},1")?;
+    } else {
+        writeln!(w, "PSHELL,{solid},1,1.")?;
+    }
+    let mut tags: Vec<i32> = skin.iter().map(|&(_, t)| t).collect();
+    tags.dedup();
+    for tag in tags {
+        writeln!(w, "PSHELL,{tag}")?;
     }
     writeln!(w, "ENDDATA")
 }
@@ -255,6 +307,68 @@ GRID          99            junk\r\n";
     }
 
     #[test]
+    fn skin_triangles_are_facet_tags_by_property_id() {
+        let path = Path::new("x.nas");
+        let (_, data) = read(path, TWO_TETS.as_bytes()).unwrap().finish::<3>(path).unwrap();
+        assert_eq!(data.facet_tags, std::collections::BTreeMap::from([(vec![0, 1, 2], 375)]));
+    }
+
+    #[test]
+    fn writes_the_boundary_as_outward_skin_groups_under_their_own_properties() {
+        // A cube of six tets around its diagonal; two facets of the face z = 0 tagged 4 and one
+        // of x = 1 tagged 9, the rest of the boundary untagged.
+        let vertices: Vec<[f64; 3]> =
+            (0..8).map(|k| [(k & 1) as f64, ((k >> 1) & 1) as f64, ((k >> 2) & 1) as f64]).collect();
+        let cells = vec![0, 1, 3, 7, 0, 1, 5, 7, 0, 2, 3, 7, 0, 2, 6, 7, 0, 4, 5, 7, 0, 4, 6, 7];
+        let mesh = Mesh3::new_reoriented(vertices, cells).unwrap();
+        let data = MeshData::new()
+            .with_facet_tag(vec![0, 1, 3], 4)
+            .with_facet_tag(vec![0, 2, 3], 4)
+            .with_facet_tag(vec![1, 3, 7], 9);
+        let path = Path::new("cube.nas");
+        for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+            let mut bytes = Vec::new();
+            write(&Nodes::new(&mesh, order), &data, &mut bytes, path).unwrap();
+            let text = String::from_utf8(bytes.clone()).unwrap();
+            // 12 boundary triangles: 3 tagged, 9 under one past the largest tag; the solid after them.
+            assert!(
+                text.contains("PSOLID,11,1\n") && text.contains("PSHELL,4\n") && text.contains("PSHELL,9\n"),
+                "{text}"
+            );
+            assert!(text.contains("PSHELL,10\n"));
+            let skin = if order == ElementOrder::Linear { "CTRIA3," } else { "CTRIA6," };
+            assert_eq!(text.matches(skin).count(), 12);
+            assert_eq!(
+                text.lines().filter(|l| l.starts_with("CTETRA,") && l.split(',').nth(2) == Some("11")).count(),
+                6
+            );
+            let (back, back_data) = read(path, &bytes).unwrap().finish::<3>(path).unwrap();
+            assert_eq!((back.vertices(), back.cells()), (mesh.vertices(), mesh.cells()));
+            assert_eq!(back_data.facet_tags.len(), 12);
+            assert_eq!(back_data.facet_tags.values().filter(|&&t| t == 10).count(), 9);
+            for (facet, tag) in &data.facet_tags {
+                assert_eq!(back_data.facet_tags.get(facet), Some(tag));
+            }
+            // Each skin triangle's grids turn counter-clockwise seen from outside the cube.
+            let centre = [0.5; 3];
+            for line in text.lines().filter(|l| l.starts_with(skin)) {
+                let grid: Vec<usize> =
+                    line.split(',').skip(3).take(3).map(|g| g.parse::<usize>().unwrap() - 1).collect();
+                let p = |i: usize| mesh.vertices()[grid[i]];
+                let (a, b, c) = (p(0), p(1), p(2));
+                let (u, v) = ([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]);
+                let normal = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+                let outward: f64 = (0..3).map(|k| normal[k] * (a[k] - centre[k])).sum();
+                assert!(outward > 0.0, "{line}");
+            }
+        }
+        let negative = MeshData::new().with_facet_tag(vec![0, 1, 3], -2);
+        let message =
+            write(&Nodes::new(&mesh, ElementOrder::Linear), &negative, &mut Vec::new(), path).unwrap_err().to_string();
+        assert!(message.contains("cube.nas") && message.contains("positive"), "{message}");
+    }
+
+    #[test]
     fn nastran_reals() {
         let cases = [
             ("-7.11-15", -7.11e-15),
@@ -321,7 +435,7 @@ GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nGRID,5,,1.,1.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA
         let triangle = |x| Mesh2::new(vec![[0.0, 0.0], [1.0, 0.0], [x, 1.0]], vec![0, 1, 2]).unwrap();
         for x in [0.25, 1.0 / 3.0] {
             let mut bytes = Vec::new();
-            write(&Nodes::new(&triangle(x), ElementOrder::Linear), &mut bytes).unwrap();
+            write(&Nodes::new(&triangle(x), ElementOrder::Linear), &MeshData::new(), &mut bytes, path).unwrap();
             let back = read(path, &bytes).unwrap().finish::<2>(path).unwrap().0;
             assert!((back.vertices()[2][0] - x).abs() <= 5e-11 * x, "{x}: {back:?}");
             assert_eq!((back.cells(), &back.vertices()[..2]), (triangle(x).cells(), &triangle(x).vertices()[..2]));
