@@ -24,7 +24,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Mesh a geometry with a trained model (or a sizing field); write .vtu, .msh, .json or .png.
+    /// Mesh a geometry with a trained model (or a sizing field); write .msh, .vtu, .inp, .nas, .vtk, .mesh, .json or .png.
     Mesh(mesh::MeshArgs),
     /// Train AMBER on a folder of expert meshes (--data DIR with train/ and val/) or on Poisson
     /// problems (resumes a killed run in the same --out directory).

@@ -108,7 +108,8 @@ pub struct MeshArgs {
     #[arg(long, default_value_t = 5_000_000)]
     max_elements: usize,
     /// Output: .vtu (ParaView), .msh (gmsh 4.1, one physical group per CAD face), .inp (Abaqus),
-    /// .nas (NASTRAN), .vtk, .mesh (medit), .json, or .png (a picture coloured by element size).
+    /// .nas (NASTRAN, one skin PSHELL per CAD face), .vtk, .mesh (medit), .json, or .png (a
+    /// picture coloured by element size).
     #[arg(short, long, required_unless_present = "list_faces")]
     output: Option<PathBuf>,
     /// Print the pieces of the geometry's boundary that --refine-face and the written mesh's
