@@ -70,8 +70,7 @@ impl<'m, const D: usize> PointLocator<'m, D> {
         let mut best: Option<(f64, usize)> = None;
         for candidate in self.boxes.locate_in_envelope_intersecting(AABB::from_point(p)) {
             let e = candidate.data as usize;
-            let depth = self.min_barycentric(e, p);
-            if depth >= -CONTAINMENT_TOLERANCE {
+            if let Some(depth) = self.containment_depth(e, p) {
                 let better = match best {
                     None => true,
                     Some((d, b)) => depth > d || (depth == d && e < b),
@@ -97,8 +96,10 @@ impl<'m, const D: usize> PointLocator<'m, D> {
         self.midpoints.nearest_neighbor(p).expect("Mesh::new refuses meshes without elements").data as usize
     }
 
-    /// The smallest barycentric coordinate of `p` in element `e` (≥ 0 inside).
-    fn min_barycentric(&self, e: usize, p: [f64; D]) -> f64 {
+    /// The smallest barycentric coordinate of `p` in element `e`, or `None` as soon as one is
+    /// below −[`CONTAINMENT_TOLERANCE`]: most candidates of a box query are outside, and how far
+    /// does not matter.
+    fn containment_depth(&self, e: usize, p: [f64; D]) -> Option<f64> {
         let cell = self.mesh.element(e);
         let vertices = self.mesh.vertices();
         let volume = signed_volume::<D>(vertices, cell);
@@ -107,13 +108,17 @@ impl<'m, const D: usize> PointLocator<'m, D> {
             local[j] = vertices[v as usize];
         }
         let ids = [0u32, 1, 2, 3];
-        (0..=D)
-            .map(|i| {
-                let mut q = local;
-                q[i] = p;
-                signed_volume::<D>(&q, &ids[..=D]) / volume
-            })
-            .fold(f64::INFINITY, f64::min)
+        let mut depth = f64::INFINITY;
+        for i in 0..=D {
+            let mut q = local;
+            q[i] = p;
+            let coordinate = signed_volume::<D>(&q, &ids[..=D]) / volume;
+            if coordinate < -CONTAINMENT_TOLERANCE {
+                return None;
+            }
+            depth = depth.min(coordinate);
+        }
+        Some(depth)
     }
 }
 
