@@ -423,6 +423,17 @@ fn tagged_facets<const D: usize>(
     Ok(facets)
 }
 
+/// Fails unless every tag of `facets` is positive, which `what` (the format's groups) needs.
+fn require_positive_tags(facets: &[(Vec<u32>, i32)], path: &Path, what: &str) -> Result<(), MeshError> {
+    match facets.iter().find(|(_, t)| *t <= 0) {
+        Some((_, tag)) => Err(MeshError::Format {
+            path: path.to_owned(),
+            message: format!("facet tag {tag}: {what} need positive tags"),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Every file this crate writes goes through amber-stdx's atomic writer (temporary file,
 /// fsync, rename); its file errors become [`MeshError::Io`].
 pub(crate) use amber_stdx::write_atomic_with as write_atomic;

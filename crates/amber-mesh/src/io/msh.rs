@@ -20,7 +20,7 @@ use std::path::Path;
 use super::cursor::{Cursor, Scalar};
 use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
-use super::{MeshData, tagged_facets, write_error, writer_adjacency};
+use super::{MeshData, require_positive_tags, tagged_facets, write_error, writer_adjacency};
 use crate::MeshError;
 
 /// The kind and node count of a gmsh element type.
@@ -484,10 +484,7 @@ pub(super) fn write<const D: usize>(
         }
     }
     let facets = tagged_facets(nodes.mesh(), &writer_adjacency(nodes.mesh(), path)?, data, path)?;
-    if let Some((_, tag)) = facets.iter().find(|(_, t)| *t <= 0) {
-        let message = format!("facet tag {tag}: gmsh physical groups need positive tags");
-        return Err(MeshError::Format { path: path.to_owned(), message });
-    }
+    require_positive_tags(&facets, path, "gmsh physical groups")?;
     write_body(nodes, data, &facets, &mut Out { w, binary, first: true }).map_err(write_error(path))
 }
 

@@ -26,7 +26,7 @@ use std::path::Path;
 
 use super::nodes::Nodes;
 use super::raw::{Kind, RawMesh};
-use super::{Lines, MeshData, MeshError, tagged_facets, write_error, writer_adjacency};
+use super::{Lines, MeshData, MeshError, require_positive_tags, tagged_facets, write_error, writer_adjacency};
 
 /// The kind of an element card (a CTETRA with edge grids is found by its fields).
 fn element_card(card: &str) -> Option<Kind> {
@@ -135,10 +135,7 @@ pub(super) fn write<const D: usize>(
 ) -> Result<(), MeshError> {
     let mesh = nodes.mesh();
     let skin = if D == 3 { tagged_facets(mesh, &writer_adjacency(mesh, path)?, data, path)? } else { Vec::new() };
-    if let Some((_, tag)) = skin.iter().find(|(_, t)| *t <= 0) {
-        let message = format!("facet tag {tag}: NASTRAN property ids need positive tags");
-        return Err(MeshError::Format { path: path.to_owned(), message });
-    }
+    require_positive_tags(&skin, path, "NASTRAN property ids")?;
     let solid = skin.iter().map(|&(_, t)| t).max().map_or(1, |t| t.saturating_add(1));
     write_body(nodes, &skin, solid, w).map_err(write_error(path))
 }
