@@ -144,6 +144,36 @@ mod tests {
     }
 
     #[test]
+    fn solids_are_cut_by_planes() {
+        // A 20 × 12 × 8 grid of points with its 6-neighbour graph: the first cut is across x, its
+        // widest axis, and its separator, eliminated last, is the plane x = 9.
+        let (k, l, m) = (20, 12, 8);
+        let n = k * l * m;
+        let id = |i: usize, j: usize, h: usize| (h * l + j) * k + i;
+        let points: Vec<[f64; 3]> =
+            (0..n).map(|v| [(v % k) as f64, ((v / k) % l) as f64, (v / (k * l)) as f64]).collect();
+        let (mut start, mut adjacency) = (vec![0u32], Vec::new());
+        for v in 0..n {
+            let (i, j, h) = (v % k, (v / k) % l, v / (k * l));
+            let steps = [
+                (i > 0, [i.wrapping_sub(1), j, h]),
+                (i + 1 < k, [i + 1, j, h]),
+                (j > 0, [i, j.wrapping_sub(1), h]),
+                (j + 1 < l, [i, j + 1, h]),
+                (h > 0, [i, j, h.wrapping_sub(1)]),
+                (h + 1 < m, [i, j, h + 1]),
+            ];
+            adjacency.extend(steps.iter().filter(|s| s.0).map(|s| id(s.1[0], s.1[1], s.1[2]) as u32));
+            start.push(adjacency.len() as u32);
+        }
+        let order = nested_dissection(&points, &start, &adjacency);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..n as u32).collect::<Vec<_>>());
+        assert!(order[n - l * m..].iter().all(|&v| points[v as usize][0] == 9.0));
+    }
+
+    #[test]
     fn the_order_does_not_depend_on_the_thread_count() {
         let (points, start, adjacency) = grid(150, 120);
         let on = |threads| {
