@@ -9,7 +9,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
 
-use crate::space::{NO_DOF, parallel_lists};
+use crate::space::{NESTED_DISSECTION_MIN_DOFS, NO_DOF, parallel_lists};
 use crate::{FemError, Load, P1Space, Quadrature};
 
 /// The upper triangle (diagonal included) of the symmetric stiffness matrix on the degrees of
@@ -73,7 +73,7 @@ impl<const D: usize> P1Space<'_, D> {
         let (col_ptr, column_entries) = parallel_lists(&self.vertex_of, |c, v, column: &mut Vec<(u32, f64)>| {
             let c = c as u32;
             let first = column.len();
-            for &e in &self.around[self.around_start[v as usize] as usize..self.around_start[v as usize + 1] as usize] {
+            for &e in self.around.around(v as usize) {
                 let cell = self.mesh.element(e as usize);
                 let g = &self.geometry[e as usize];
                 let a = cell.iter().position(|&w| w == v).expect("the element is around its vertex");
@@ -94,8 +94,10 @@ impl<const D: usize> P1Space<'_, D> {
             column[first..].sort_unstable_by_key(|&(row, _)| row);
         });
         let (row_idx, values) = column_entries.into_iter().unzip();
-        let ordering = if self.dissected { Elimination::AsNumbered } else { Elimination::Amd };
-        StiffnessMatrix { dofs: self.num_dofs, col_ptr, row_idx, values, ordering }
+        // The space numbers large systems in nested-dissection order, which the factor keeps.
+        let dofs = self.num_dofs();
+        let ordering = if dofs >= NESTED_DISSECTION_MIN_DOFS { Elimination::AsNumbered } else { Elimination::Amd };
+        StiffnessMatrix { dofs, col_ptr, row_idx, values, ordering }
     }
 
     /// Evaluates f at the points of `quadrature` in every element (the reference uses degree 2).
@@ -119,7 +121,7 @@ impl<const D: usize> P1Space<'_, D> {
 
     /// Assembles F_i = ∫ f φ_i over the degrees of freedom.
     pub fn load_vector(&self, samples: &LoadSamples<'_>) -> Vec<f64> {
-        let mut rhs = vec![0.0; self.num_dofs];
+        let mut rhs = vec![0.0; self.num_dofs()];
         for (e, cell) in self.mesh.elements().enumerate() {
             for ((lambda, w), fq) in samples.quadrature.iter().zip(samples.element(e)) {
                 let scaled = self.geometry[e].volume * w * fq;
@@ -242,7 +244,6 @@ impl StiffnessMatrix {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::space::NESTED_DISSECTION_MIN_DOFS;
     use amber_mesh::{Mesh2, Mesh3};
     use std::f64::consts::PI;
 

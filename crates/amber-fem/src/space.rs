@@ -1,7 +1,7 @@
 //! The P1 Lagrange space on a simplicial mesh with homogeneous Dirichlet conditions on the whole
 //! boundary: element geometry, degrees of freedom, and per-element statistics of a solution.
 
-use amber_mesh::{FacetAdjacency, Mesh};
+use amber_mesh::{FacetAdjacency, Mesh, VertexElements};
 use rayon::prelude::*;
 
 use crate::FemError;
@@ -80,12 +80,8 @@ pub struct P1Space<'m, const D: usize> {
     pub(crate) dof: Vec<u32>,
     /// The vertex of each degree of freedom.
     pub(crate) vertex_of: Vec<u32>,
-    pub(crate) num_dofs: usize,
-    /// Whether the degrees of freedom are numbered in nested-dissection order (large meshes).
-    pub(crate) dissected: bool,
-    /// The elements around each vertex, in element order: `around[around_start[v]..around_start[v + 1]]`.
-    pub(crate) around_start: Vec<u32>,
-    pub(crate) around: Vec<u32>,
+    /// The elements around each vertex.
+    pub(crate) around: VertexElements,
 }
 
 impl<'m, const D: usize> P1Space<'m, D> {
@@ -95,32 +91,16 @@ impl<'m, const D: usize> P1Space<'m, D> {
     pub fn new(mesh: &'m Mesh<D>) -> Result<Self, FemError> {
         let adjacency = FacetAdjacency::new(mesh)?;
         let boundary = adjacency.boundary_vertices(mesh);
-        let mut around_start = vec![0u32; mesh.num_vertices() + 1];
-        for &v in mesh.cells() {
-            around_start[v as usize + 1] += 1;
-        }
-        for v in 0..mesh.num_vertices() {
-            around_start[v + 1] += around_start[v];
-        }
-        let mut fill = around_start.clone();
-        let mut around = vec![0u32; mesh.cells().len()];
-        for (e, cell) in mesh.elements().enumerate() {
-            for &v in cell {
-                around[fill[v as usize] as usize] = e as u32;
-                fill[v as usize] += 1;
-            }
-        }
+        let around = VertexElements::of_mesh(mesh);
         let mut vertex_of: Vec<u32> = (0..mesh.num_vertices() as u32).filter(|&v| !boundary[v as usize]).collect();
         let mut dof = vec![NO_DOF; mesh.num_vertices()];
         for (d, &v) in vertex_of.iter().enumerate() {
             dof[v as usize] = d as u32;
         }
-        let num_dofs = vertex_of.len();
-        let dissected = num_dofs >= NESTED_DISSECTION_MIN_DOFS;
-        if dissected {
+        if vertex_of.len() >= NESTED_DISSECTION_MIN_DOFS {
             let (neighbours_start, neighbours) = parallel_lists(&vertex_of, |_, v, out| {
                 let first = out.len();
-                for &e in &around[around_start[v as usize] as usize..around_start[v as usize + 1] as usize] {
+                for &e in around.around(v as usize) {
                     for &w in mesh.element(e as usize) {
                         let d = dof[w as usize];
                         if w != v && d != NO_DOF && !out[first..].contains(&d) {
@@ -137,7 +117,7 @@ impl<'m, const D: usize> P1Space<'m, D> {
             }
         }
         let geometry = (0..mesh.num_elements()).into_par_iter().map(|e| ElementGeometry::new(mesh, e)).collect();
-        Ok(Self { mesh, adjacency, geometry, dof, vertex_of, num_dofs, dissected, around_start, around })
+        Ok(Self { mesh, adjacency, geometry, dof, vertex_of, around })
     }
 
     /// The mesh.
@@ -157,7 +137,7 @@ impl<'m, const D: usize> P1Space<'m, D> {
 
     /// Number of degrees of freedom (interior vertices).
     pub fn num_dofs(&self) -> usize {
-        self.num_dofs
+        self.vertex_of.len()
     }
 
     /// The vertex values of `u` on `element`, in local order.

@@ -2,6 +2,43 @@
 
 use crate::{Mesh, MeshError};
 
+/// The elements around each vertex, in element order (compressed rows, built by a counting sort).
+#[derive(Clone, Debug)]
+pub struct VertexElements {
+    offsets: Vec<u32>,
+    elements: Vec<u32>,
+}
+
+impl VertexElements {
+    /// The table of `cells` (`nodes_per_element` vertex indices each, all below `num_vertices`).
+    pub fn new(num_vertices: usize, cells: &[u32], nodes_per_element: usize) -> Self {
+        let mut offsets = vec![0u32; num_vertices + 1];
+        for &v in cells {
+            offsets[v as usize + 1] += 1;
+        }
+        for v in 0..num_vertices {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut fill = offsets.clone();
+        let mut elements = vec![0u32; cells.len()];
+        for (k, &v) in cells.iter().enumerate() {
+            elements[fill[v as usize] as usize] = (k / nodes_per_element) as u32;
+            fill[v as usize] += 1;
+        }
+        Self { offsets, elements }
+    }
+
+    /// The table of a mesh's elements.
+    pub fn of_mesh<const D: usize>(mesh: &Mesh<D>) -> Self {
+        Self::new(mesh.num_vertices(), mesh.cells(), D + 1)
+    }
+
+    /// The elements containing `vertex`, ascending.
+    pub fn around(&self, vertex: usize) -> &[u32] {
+        &self.elements[self.offsets[vertex] as usize..self.offsets[vertex + 1] as usize]
+    }
+}
+
 /// For every element and local facet (the facet opposite local vertex `i`), the neighbouring
 /// element across it, or none on the boundary.
 #[derive(Clone, Debug)]
@@ -35,8 +72,13 @@ impl FacetAdjacency {
         };
         let slots = mesh.cells().len();
         let mut start = vec![0u32; mesh.num_vertices() + 1];
+        // A facet's smallest vertex, its key's first, needs no sort.
+        let smallest = |slot: usize| {
+            let cell = mesh.element(slot / n);
+            outward_facets::<D>()[slot % n].iter().map(|&j| cell[j]).min().unwrap_or(0)
+        };
         for slot in 0..slots {
-            start[key_of(slot).0[0] as usize + 1] += 1;
+            start[smallest(slot) as usize + 1] += 1;
         }
         for v in 0..mesh.num_vertices() {
             start[v + 1] += start[v];

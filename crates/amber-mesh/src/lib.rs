@@ -16,7 +16,7 @@ mod io;
 mod locate;
 mod mesh;
 
-pub use adjacency::FacetAdjacency;
+pub use adjacency::{FacetAdjacency, VertexElements};
 pub use error::MeshError;
 pub use io::{
     AnyMesh, ElementOrder, Encoding, MESH_FORMATS, MeshData, StlFaceIds, TriangleSoup, WriteOptions, check_output,

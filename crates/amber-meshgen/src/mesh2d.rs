@@ -15,7 +15,7 @@
 use std::cmp::Ordering;
 use std::collections::VecDeque;
 
-use amber_mesh::Mesh2;
+use amber_mesh::{Mesh2, VertexElements};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{
     ConstrainedDelaunayTriangulation, Intersection, LineIntersectionIterator, Point2, PositionInTriangulation,
@@ -441,10 +441,10 @@ fn smooth(vertices: &mut [[f64; 2]], triangles: &[u32], segments: &[[usize; 2]],
         fixed[s[0]] = true;
         fixed[s[1]] = true;
     }
-    let star = Csr::vertex_to_triangles(n, triangles);
+    let star = VertexElements::new(n, triangles, 3);
     for _ in 0..passes {
         for v in 0..n {
-            let around = star.row(v);
+            let around = star.around(v);
             if fixed[v] || around.is_empty() {
                 continue;
             }
@@ -540,35 +540,6 @@ fn star_quality(vertices: &[[f64; 2]], triangles: &[u32], star: &[u32]) -> f64 {
             twice_area * twice_area.abs() / longer_product
         })
         .fold(f64::INFINITY, f64::min)
-}
-
-/// Compressed rows: for each vertex, the triangles containing it.
-struct Csr {
-    offsets: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl Csr {
-    fn vertex_to_triangles(num_vertices: usize, triangles: &[u32]) -> Self {
-        let mut offsets = vec![0u32; num_vertices + 1];
-        for &v in triangles {
-            offsets[v as usize + 1] += 1;
-        }
-        for i in 0..num_vertices {
-            offsets[i + 1] += offsets[i];
-        }
-        let mut fill = offsets.clone();
-        let mut items = vec![0u32; triangles.len()];
-        for (k, &v) in triangles.iter().enumerate() {
-            items[fill[v as usize] as usize] = (k / 3) as u32;
-            fill[v as usize] += 1;
-        }
-        Self { offsets, items }
-    }
-
-    fn row(&self, i: usize) -> &[u32] {
-        &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize]
-    }
 }
 
 #[cfg(test)]
