@@ -98,8 +98,8 @@ pub struct MeshArgs {
     /// Also write every step's mesh (`step<t>.vtu`) and picture (`step<t>.png`) here.
     #[arg(long)]
     every_step: Option<PathBuf>,
-    /// Surfaces without CAD faces (a plain STL, a mesh boundary) are split into faces at edges
-    /// sharper than this many degrees.
+    /// Surfaces without CAD faces (a plain STL, a mesh without boundary groups) are split into
+    /// faces at edges sharper than this many degrees.
     #[arg(long, default_value_t = FEATURE_ANGLE_DEGREES)]
     feature_angle: f64,
     /// Refuse to build more elements than this. A model's own field is first held to the model's

@@ -58,7 +58,7 @@ pub fn mesh_file(data: &[u8]) {
         Ok(AnyMesh::Three(mesh, data)) => {
             assert_valid(&mesh);
             assert_written_back(&mesh, &data);
-            if let Ok(mut surface) = Surface::from_mesh_boundary(&mesh) {
+            if let Ok(mut surface) = Surface::from_mesh_boundary(&mesh, &data.facet_tags) {
                 surface.split_faces_at_feature_edges(30.0);
                 let _ = surface.validate();
             }

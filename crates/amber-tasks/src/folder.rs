@@ -23,7 +23,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use amber_mesh::{MESH_FORMATS, Mesh, MeshError, read_mesh};
+use amber_mesh::{MESH_FORMATS, Mesh, MeshData, MeshError, read_mesh, read_mesh_with_data};
 use amber_stdx::{median, read_json};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -153,6 +153,9 @@ pub struct Expert<const D: usize> {
     /// The expert mesh's file.
     pub path: PathBuf,
     pub mesh: Mesh<D>,
+    /// The expert file's facet tags (physical groups, skin properties): the faces of a solid's
+    /// boundary when it has no geometry file.
+    pub facet_tags: BTreeMap<Vec<u32>, i32>,
     /// The geometry file (beside the mesh or under [`GEOMETRY_DIR`]); `None`: the mesh's boundary.
     pub geometry: Option<PathBuf>,
     /// The part's inputs file (`<stem>.inputs.json` beside the mesh or under [`GEOMETRY_DIR`]).
@@ -201,15 +204,15 @@ fn part_files(dir: &Path) -> Result<BTreeMap<String, Vec<PathBuf>>, TaskError> {
 
 /// Reads the expert mesh among `files` (one stem's files): the file `read_mesh` reads, a `.json`
 /// only when no other file is a mesh. `Ok(None)`: no file of the stem is a mesh.
-fn read_part_mesh<const D: usize>(files: &[PathBuf]) -> Result<Option<(PathBuf, Mesh<D>)>, TaskError> {
+fn read_part_mesh<const D: usize>(files: &[PathBuf]) -> Result<Option<(PathBuf, Mesh<D>, MeshData)>, TaskError> {
     let (json, others): (Vec<&PathBuf>, Vec<&PathBuf>) = files.iter().partition(|p| extension(p) == "json");
-    let mut found: Option<(PathBuf, Mesh<D>)> = None;
+    let mut found: Option<(PathBuf, Mesh<D>, MeshData)> = None;
     for path in others.into_iter().chain(json) {
         if found.is_some() && extension(path) == "json" {
             continue;
         }
-        let mesh = match read_mesh::<D>(path) {
-            Ok(mesh) => mesh,
+        let (mesh, data) = match read_mesh_with_data::<D>(path) {
+            Ok(read) => read,
             Err(MeshError::UnsupportedFormat { .. }) => continue,
             Err(MeshError::DimensionMismatch { found: other, .. }) => {
                 return Err(TaskError::Dataset {
@@ -219,13 +222,13 @@ fn read_part_mesh<const D: usize>(files: &[PathBuf]) -> Result<Option<(PathBuf, 
             }
             Err(e) => return Err(TaskError::ExpertMesh(e)),
         };
-        if let Some((first, _)) = &found {
+        if let Some((first, ..)) = &found {
             return Err(TaskError::Dataset {
                 path: path.clone(),
                 message: format!("a second expert mesh of the part (the first is {})", first.display()),
             });
         }
-        found = Some((path.clone(), mesh));
+        found = Some((path.clone(), mesh, data));
     }
     Ok(found)
 }
@@ -301,10 +304,11 @@ pub fn read_experts<const D: usize>(dir: &Path, limit: Option<usize>) -> Result<
         let read: Vec<Option<Expert<D>>> = batch
             .par_iter()
             .map(|(stem, files)| {
-                Ok(read_part_mesh::<D>(files)?.map(|(path, mesh)| {
+                Ok(read_part_mesh::<D>(files)?.map(|(path, mesh, data)| {
                     let geometry = find_geometry(dir, stem, files, &path, D);
                     let inputs = find_inputs(dir, stem);
-                    Expert { name: format!("{split}/{stem}"), path, mesh, geometry, inputs }
+                    let facet_tags = data.facet_tags;
+                    Expert { name: format!("{split}/{stem}"), path, mesh, facet_tags, geometry, inputs }
                 }))
             })
             .collect::<Result<_, TaskError>>()?;
@@ -357,7 +361,7 @@ impl FolderDomain<3> for SolidPart {
     fn from_expert(expert: &Expert<3>, initial_size: f64, settings: &DatasetSettings) -> Result<Self, TaskError> {
         let surface = match &expert.geometry {
             Some(path) => read_solid_surface(path, settings.feature_angle(), initial_size)?,
-            None => solid_surface_of_mesh(&expert.path, &expert.mesh, settings.feature_angle())?,
+            None => solid_surface_of_mesh(&expert.path, &expert.mesh, &expert.facet_tags, settings.feature_angle())?,
         };
         let bounds = amber_mesh::bounding_box(surface.vertices()).expect("a validated surface has vertices");
         check_geometry(expert, bounds, surface.enclosed_volume())?;
@@ -612,7 +616,7 @@ mod tests {
 
     /// Writes the boundary of `mesh` as an ASCII STL file.
     fn write_boundary_stl(mesh: &Mesh<3>, path: &Path) {
-        let surface = amber_meshgen::mesh3d::Surface::from_mesh_boundary(mesh).unwrap();
+        let surface = amber_meshgen::mesh3d::Surface::from_mesh_boundary(mesh, &BTreeMap::new()).unwrap();
         let mut stl = String::from("solid part\n");
         for t in surface.triangles() {
             stl += "facet normal 0 0 0\nouter loop\n";

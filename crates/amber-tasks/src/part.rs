@@ -28,9 +28,10 @@ pub const FEATURE_ANGLE_DEGREES: f64 = 30.0;
 /// faces come from the file (the STL facet attribute or `solid` blocks, OBJ groups), a CAD file
 /// (STEP, IGES, BREP; tessellated by gmsh with triangles up to
 /// [`TESSELLATION_SIZE_PER_INITIAL_SIZE`] × `initial_size`, M⁰'s element size), or the boundary
-/// of a tet mesh in any format amber reads. A surface with a single face (a plain STL, a mesh
-/// boundary) is split into faces at edges sharper than `feature_angle` degrees, since the
-/// generator keeps vertices on their own face and curves.
+/// of a tet mesh in any format amber reads (its faces the file's boundary groups). A surface
+/// with a single face (a plain STL, a mesh boundary without groups) is split into faces at
+/// edges sharper than `feature_angle` degrees, since the generator keeps vertices on their own
+/// face and curves.
 pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) -> Result<Surface, TaskError> {
     let geometry = |message: String| TaskError::Geometry { path: path.into(), message };
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
@@ -46,16 +47,22 @@ pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) ->
             validated_solid(path, surface, feature_angle)
         }
         None => match read_any_mesh(path).map_err(|e| geometry(format!("neither a surface nor a tet mesh: {e}")))? {
-            AnyMesh::Three(mesh, _) => solid_surface_of_mesh(path, &mesh, feature_angle),
+            AnyMesh::Three(mesh, data) => solid_surface_of_mesh(path, &mesh, &data.facet_tags, feature_angle),
             AnyMesh::Two(..) => Err(geometry("holds triangles (a 2D geometry), not a solid".into())),
         },
     }
 }
 
-/// The boundary of the tet mesh `mesh` (read from `path`) as a validated surface, split into
-/// faces at edges sharper than `feature_angle` degrees.
-pub(crate) fn solid_surface_of_mesh(path: &Path, mesh: &Mesh3, feature_angle: f64) -> Result<Surface, TaskError> {
-    let surface = Surface::from_mesh_boundary(mesh)
+/// The boundary of the tet mesh `mesh` (read from `path`) as a validated surface, its faces the
+/// file's `facet_tags` (physical groups, skin properties) when they name more than one, else
+/// split at edges sharper than `feature_angle` degrees.
+pub(crate) fn solid_surface_of_mesh(
+    path: &Path,
+    mesh: &Mesh3,
+    facet_tags: &BTreeMap<Vec<u32>, i32>,
+    feature_angle: f64,
+) -> Result<Surface, TaskError> {
+    let surface = Surface::from_mesh_boundary(mesh, facet_tags)
         .map_err(|e| TaskError::Geometry { path: path.into(), message: format!("boundary of the tet mesh: {e}") })?;
     validated_solid(path, surface, feature_angle)
 }
@@ -444,6 +451,36 @@ mod tests {
             assert!(facet.iter().all(|&i| mesh.vertices()[i as usize][axis] == value), "{facet:?} on face {face}");
         }
         assert_eq!(tags.values().copied().collect::<std::collections::BTreeSet<_>>().len(), 6);
+    }
+
+    /// A tet mesh given as the geometry keeps its file's boundary groups as its faces: z = 0 and
+    /// z = 1 in group 7, the other four sides in group 3, two faces where a split at its edges
+    /// would make six; then meshing it tags its boundary with those groups.
+    #[test]
+    fn a_mesh_file_as_geometry_keeps_its_boundary_groups() {
+        let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
+        let sides = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let triangles = sides.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+        let faces = (1..=6).flat_map(|f| [f; 2]).collect();
+        let part = SolidPart::new("cube".into(), Surface::new(v, triangles, faces).unwrap(), 0.3).unwrap();
+        let mesh = &part.initial_mesh;
+        let group = |face: i32| if face <= 2 { 7 } else { 3 };
+        let facet_tags = part.boundary_tags(mesh).into_iter().map(|(facet, face)| (facet, group(face))).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("cube.msh");
+        amber_mesh::write_mesh(mesh, &path, &amber_mesh::MeshData { facet_tags, ..Default::default() }).unwrap();
+
+        let surface = read_solid_surface(&path, FEATURE_ANGLE_DEGREES, 0.3).unwrap();
+        let on_a_z_side = |t: &[u32; 3]| {
+            let z = t.map(|i| surface.vertices()[i as usize][2]);
+            z.iter().all(|&z| z == 0.0) || z.iter().all(|&z| z == 1.0)
+        };
+        for (t, &face) in surface.triangles().iter().zip(surface.face_ids()) {
+            assert_eq!(face, if on_a_z_side(t) { 7 } else { 3 }, "{t:?}");
+        }
+        let remeshed = SolidPart::new("cube".into(), surface, 0.3).unwrap();
+        let tags = remeshed.boundary_tags(&remeshed.initial_mesh);
+        assert_eq!(tags.values().copied().collect::<std::collections::BTreeSet<_>>(), [3, 7].into());
     }
 
     /// Every element of an L-shaped plate gets the geometry inputs, no element is farther from

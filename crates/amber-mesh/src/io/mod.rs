@@ -50,8 +50,9 @@ pub struct MeshData {
     /// physical group per tag (tags must be positive); without tags it writes one group for the
     /// whole boundary.
     pub facet_tags: BTreeMap<Vec<u32>, i32>,
-    /// Elements a reader dropped because they are not simplices of the mesh dimension, counted
-    /// by kind (`line`, `quad`, `hexahedron`, ...). Writers ignore it.
+    /// Elements a reader dropped because they are neither simplices of the mesh dimension nor
+    /// tagged facets (those are in `facet_tags`), counted by kind (`line`, `quad`, `hexahedron`,
+    /// ...). Writers ignore it.
     pub dropped: BTreeMap<String, usize>,
     /// Quadratic simplices of the mesh dimension (`tetra10`, `triangle6`) a reader kept as the
     /// linear simplices of their corners, their edge nodes dropped, counted by kind. Writers

@@ -674,7 +674,7 @@ $Elements\r\n3 5 1 9\r\n0 1 15 1\r\n1 10\r\n1 1 1 2\r\n2 10 20\r\n3 20 30\r\n2 1
         assert_eq!(mesh.num_elements(), 2);
         assert!(mesh.volumes().iter().all(|&v| (v - 0.5).abs() < 1e-15));
         assert_eq!(data.facet_tags, BTreeMap::from([(vec![0, 1], 5), (vec![1, 2], 5)]));
-        assert_eq!(data.dropped, BTreeMap::from([("line".into(), 2), ("vertex".into(), 1)]));
+        assert_eq!(data.dropped, BTreeMap::from([("vertex".into(), 1)]));
         assert!(matches!(parse::<3>(GMSH_2D), Err(MeshError::DimensionMismatch { expected: 3, found: 2, .. })));
     }
 

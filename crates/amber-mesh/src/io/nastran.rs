@@ -308,6 +308,7 @@ GRID          99            junk\r\n";
         let path = Path::new("x.nas");
         let (_, data) = read(path, TWO_TETS.as_bytes()).unwrap().finish::<3>(path).unwrap();
         assert_eq!(data.facet_tags, std::collections::BTreeMap::from([(vec![0, 1, 2], 375)]));
+        assert!(data.dropped.is_empty(), "a skin triangle is a facet tag, not a dropped element: {:?}", data.dropped);
     }
 
     #[test]

@@ -184,9 +184,12 @@ impl Surface {
     }
 
     /// The boundary surface of a tet mesh: its boundary triangles, oriented outwards, over its
-    /// boundary vertices, all in face 1 (see [`Surface::split_faces_at_feature_edges`]); not yet
-    /// validated. A mesh whose facets do not pair up (three tets on one triangle) is an error.
-    pub fn from_mesh_boundary(mesh: &Mesh3) -> Result<Self, SurfaceError> {
+    /// boundary vertices; not yet validated. A triangle's face is its tag in `facet_tags` (keyed
+    /// by sorted mesh vertex indices, as [`amber_mesh::MeshData::facet_tags`]: a file's physical
+    /// groups or skin properties); the untagged ones share one face numbered after the largest
+    /// tag, face 1 without tags (see [`Surface::split_faces_at_feature_edges`]). A mesh whose
+    /// facets do not pair up (three tets on one triangle) is an error.
+    pub fn from_mesh_boundary(mesh: &Mesh3, facet_tags: &BTreeMap<Vec<u32>, i32>) -> Result<Self, SurfaceError> {
         let facets = FacetAdjacency::new(mesh)?.oriented_boundary_facets(mesh);
         let mut index = vec![u32::MAX; mesh.num_vertices()];
         let mut vertices = Vec::new();
@@ -202,7 +205,15 @@ impl Surface {
                 })
             })
             .collect();
-        let face_ids = vec![1; triangles.len()];
+        let untagged = facet_tags.values().max().map_or(1, |&largest| largest.max(0) + 1);
+        let face_ids = facets
+            .iter()
+            .map(|facet| {
+                let mut key = facet.to_vec();
+                key.sort_unstable();
+                facet_tags.get(&key).copied().unwrap_or(untagged)
+            })
+            .collect();
         Self::new(vertices, triangles, face_ids).map_err(|source| SurfaceError::Defect { path: PathBuf::new(), source })
     }
 
@@ -591,12 +602,40 @@ mod tests {
         let mut cube = cube();
         cube.validate().unwrap();
         let mesh = crate::mesh3d::generate_3d(&cube, &crate::ConstantSize(0.3), &Default::default()).unwrap();
-        let mut boundary = Surface::from_mesh_boundary(&mesh).unwrap();
+        let mut boundary = Surface::from_mesh_boundary(&mesh, &BTreeMap::new()).unwrap();
+        assert!(boundary.face_ids().iter().all(|&id| id == 1));
         boundary.split_faces_at_feature_edges(30.0);
         assert_eq!(*boundary.face_ids().iter().max().unwrap(), 6);
         let report = boundary.validate().unwrap();
         assert_eq!(report.flipped_triangles, 0, "mesh boundaries come out oriented");
         assert!((report.enclosed_volume - mesh.total_volume()).abs() < 1e-12);
+    }
+
+    /// A mesh file's facet tags become the faces of its boundary; untagged facets share the
+    /// face after the largest tag.
+    #[test]
+    fn mesh_boundary_faces_follow_the_facet_tags() {
+        let mut cube = cube();
+        cube.validate().unwrap();
+        let mesh = crate::mesh3d::generate_3d(&cube, &crate::ConstantSize(0.5), &Default::default()).unwrap();
+        let facets = FacetAdjacency::new(&mesh).unwrap().oriented_boundary_facets(&mesh);
+        let on_plane = |facet: &[u32; 3], axis: usize| facet.iter().all(|&v| mesh.vertices()[v as usize][axis] == 0.0);
+        let mut tags = BTreeMap::new();
+        for facet in &facets {
+            let mut key = facet.to_vec();
+            key.sort_unstable();
+            if on_plane(facet, 0) {
+                tags.insert(key, 4);
+            } else if on_plane(facet, 1) {
+                tags.insert(key, 9);
+            }
+        }
+        let boundary = Surface::from_mesh_boundary(&mesh, &tags).unwrap();
+        let count = |id| boundary.face_ids().iter().filter(|&&f| f == id).count();
+        assert_eq!(count(4), facets.iter().filter(|f| on_plane(f, 0)).count());
+        assert_eq!(count(9), facets.iter().filter(|f| on_plane(f, 1) && !on_plane(f, 0)).count());
+        assert_eq!(count(4) + count(9) + count(10), facets.len(), "the rest in face 10");
+        assert!(count(4) > 0 && count(9) > 0 && count(10) > 0);
     }
 
     #[test]
