@@ -152,7 +152,10 @@ fn converts_between_formats_in_the_dimension_of_the_file() {
     let output = amber().arg("convert").arg(&msh).arg(&vtk).output().unwrap();
     assert!(output.status.success());
     let summary = String::from_utf8_lossy(&output.stderr);
-    assert!(summary.contains("4 tagged facets") && !summary.contains("dropped"), "boundary lines are facets: {summary}");
+    assert!(
+        summary.contains("4 tagged facets") && !summary.contains("dropped"),
+        "boundary lines are facets: {summary}"
+    );
     let (mesh, data) = amber_mesh::read_mesh_with_data::<2>(&vtk).unwrap();
     assert_eq!((mesh.num_elements(), data.cell["size"].clone()), (2, vec![0.5, 0.25]));
 

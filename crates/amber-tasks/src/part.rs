@@ -431,19 +431,24 @@ mod tests {
         }
     }
 
-    /// A cube of six CAD faces, meshed: every boundary triangle is tagged with the face it lies
-    /// on (the coordinate that is 0 or 1 across its corners says which).
-    #[test]
-    fn boundary_triangles_are_tagged_with_their_cad_face() {
+    /// The unit cube with its six sides as CAD faces 1..=6 (z = 0, z = 1, y = 0, y = 1, x = 0,
+    /// x = 1), meshed at size 0.3.
+    fn unit_cube_part() -> SolidPart {
         let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
         let sides = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
         let triangles = sides.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
         let faces = (1..=6).flat_map(|f| [f; 2]).collect();
-        let part = SolidPart::new("cube".into(), Surface::new(v, triangles, faces).unwrap(), 0.3).unwrap();
+        SolidPart::new("cube".into(), Surface::new(v, triangles, faces).unwrap(), 0.3).unwrap()
+    }
+
+    /// A cube of six CAD faces, meshed: every boundary triangle is tagged with the face it lies
+    /// on (the coordinate that is 0 or 1 across its corners says which).
+    #[test]
+    fn boundary_triangles_are_tagged_with_their_cad_face() {
+        let part = unit_cube_part();
         let mesh = &part.initial_mesh;
         let tags = part.boundary_tags(mesh);
         assert_eq!(tags.len(), FacetAdjacency::new(mesh).unwrap().boundary_facets().count());
-        // Side k of `sides` is z = 0, z = 1, y = 0, y = 1, x = 0, x = 1.
         let plane =
             |face: i32| ([2, 2, 1, 1, 0, 0][face as usize - 1], [0.0, 1.0, 0.0, 1.0, 0.0, 1.0][face as usize - 1]);
         for (facet, &face) in &tags {
@@ -458,11 +463,7 @@ mod tests {
     /// would make six; then meshing it tags its boundary with those groups.
     #[test]
     fn a_mesh_file_as_geometry_keeps_its_boundary_groups() {
-        let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
-        let sides = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let triangles = sides.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-        let faces = (1..=6).flat_map(|f| [f; 2]).collect();
-        let part = SolidPart::new("cube".into(), Surface::new(v, triangles, faces).unwrap(), 0.3).unwrap();
+        let part = unit_cube_part();
         let mesh = &part.initial_mesh;
         let group = |face: i32| if face <= 2 { 7 } else { 3 };
         let facet_tags = part.boundary_tags(mesh).into_iter().map(|(facet, face)| (facet, group(face))).collect();
