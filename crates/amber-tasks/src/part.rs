@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use amber_graph::FeatureSet;
-use amber_mesh::{AnyMesh, FacetAdjacency, Mesh, Mesh2, Mesh3, StlFaceIds, read_any_mesh, read_surface};
+use amber_mesh::{AnyMesh, FacetAdjacency, Mesh, Mesh2, Mesh3, MeshError, StlFaceIds, read_any_mesh, read_surface};
 use amber_meshgen::mesh3d::{Mesh3dError, Mesh3dParams, Surface, SurfaceDistance, generate_3d};
 use amber_meshgen::{
     ConstantSize, Mesh2dParams, MeshSizing, MeshgenError, PolygonDistance, PolygonDomain, generate_2d, uniform_mesh_2d,
@@ -36,7 +36,7 @@ pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) ->
     let geometry = |message: String| TaskError::Geometry { path: path.into(), message };
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let soup = match extension.as_deref() {
-        Some("stl" | "obj") => Some(read_surface(path, StlFaceIds::FromFile).map_err(|e| geometry(e.to_string()))?),
+        Some("stl" | "obj") => Some(read_surface(path, StlFaceIds::FromFile).map_err(|e| unreadable(path, e, ""))?),
         _ if is_cad(path) => Some(Gmsh::default().tessellate(path, TESSELLATION_SIZE_PER_INITIAL_SIZE * initial_size)?),
         _ => None,
     };
@@ -46,10 +46,19 @@ pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) ->
                 Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(|e| geometry(e.to_string()))?;
             validated_solid(path, surface, feature_angle)
         }
-        None => match read_any_mesh(path).map_err(|e| geometry(format!("neither a surface nor a tet mesh: {e}")))? {
+        None => match read_any_mesh(path).map_err(|e| unreadable(path, e, "neither a surface nor a tet mesh: "))? {
             AnyMesh::Three(mesh, data) => solid_surface_of_mesh(path, &mesh, &data.facet_tags, feature_angle),
             AnyMesh::Two(..) => Err(geometry("holds triangles (a 2D geometry), not a solid".into())),
         },
+    }
+}
+
+/// The error of a geometry file `path` that amber could not read as a mesh or surface: a file
+/// that cannot be opened is an I/O error, anything else says what the file was expected to be.
+fn unreadable(path: &Path, error: MeshError, expected: &str) -> TaskError {
+    match error {
+        MeshError::Io { source, .. } => TaskError::Io { path: path.into(), source },
+        error => TaskError::Geometry { path: path.into(), message: format!("{expected}{error}") },
     }
 }
 
@@ -91,7 +100,7 @@ pub fn read_polygon_domain(path: &Path) -> Result<PolygonDomain, TaskError> {
             return serde_json::from_value(value).map_err(|e| geometry(format!("not a valid polygon domain: {e}")));
         }
     }
-    match read_any_mesh(path).map_err(|e| geometry(format!("neither a polygon nor a triangle mesh: {e}")))? {
+    match read_any_mesh(path).map_err(|e| unreadable(path, e, "neither a polygon nor a triangle mesh: "))? {
         AnyMesh::Two(mesh, _) => polygon_domain_of_mesh(path, &mesh),
         AnyMesh::Three(..) => Err(geometry("holds tetrahedra (a 3D geometry), not a planar domain".into())),
     }
@@ -456,6 +465,20 @@ mod tests {
             assert!(facet.iter().all(|&i| mesh.vertices()[i as usize][axis] == value), "{facet:?} on face {face}");
         }
         assert_eq!(tags.values().copied().collect::<std::collections::BTreeSet<_>>().len(), 6);
+    }
+
+    /// A geometry file that is not there is reported as such, once, whatever its format.
+    #[test]
+    fn a_missing_geometry_file_is_an_io_error() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["part.nas", "part.stl"] {
+            let path = dir.path().join(name);
+            let err = read_solid_surface(&path, FEATURE_ANGLE_DEGREES, 1.0).unwrap_err();
+            assert!(matches!(err, TaskError::Io { .. }), "{name}: {err}");
+            assert_eq!(err.to_string().matches(name).count(), 1, "{err}");
+        }
+        let err = read_polygon_domain(&dir.path().join("plate.msh")).unwrap_err();
+        assert!(matches!(err, TaskError::Io { .. }), "{err}");
     }
 
     /// A tet mesh given as the geometry keeps its file's boundary groups as its faces: z = 0 and
