@@ -80,11 +80,12 @@ pub struct MeshArgs {
     /// A piece of the boundary where 90 % of the final mesh's elements are to be no larger than
     /// SIZE (a contact face, a hole's wall, a loaded edge): `FACE,SIZE`, FACE the number of a CAD
     /// face of a solid or of a side of a polygon, as in the written mesh's `boundary_<FACE>`
-    /// groups. The last step's field is held at the fraction of SIZE of --refine-box on every
+    /// groups, or the name the geometry gives a face (a physical group of a mesh file, a solid of
+    /// an ASCII STL, a group of an OBJ; `--list-faces` lists them). The last step's field is held at the fraction of SIZE of --refine-box on every
     /// element of the mesh before it with a vertex on the face, a layer as deep as that mesh's
     /// elements there; --elements counts them in. May be given more than once.
     #[arg(long, value_parser = parse_refine_face, value_name = "FACE,SIZE")]
-    refine_face: Vec<RefineFace>,
+    refine_face: Vec<RefineFaceArg>,
     /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,
     /// and its domain when no geometry is given; its expert mesh, when present, is the default
     /// --expert), or a part's inputs (`<stem>.inputs.json`: named numbers and points) for a model
@@ -343,15 +344,29 @@ where
     }
     if !args.refine_face.is_empty() {
         let faces: BTreeSet<i32> = domain.boundary_tags(domain.initial_mesh()).into_values().collect();
+        let names = domain.boundary_names();
         for refine in &args.refine_face {
-            if !faces.contains(&refine.face) {
-                anyhow::bail!(
-                    "--refine-face: the geometry has no face {}; its faces are {}",
-                    refine.face,
-                    face_list(&faces)
-                );
+            let face = match &refine.face {
+                FaceArg::Number(face) => *face,
+                FaceArg::Name(name) => match names.iter().find(|(_, n)| *n == name) {
+                    Some((&face, _)) => face,
+                    None if names.is_empty() => anyhow::bail!(
+                        "--refine-face: the geometry names no faces, so `{name}` must be a face number; its faces \
+                         are {}",
+                        face_list(&faces)
+                    ),
+                    None => anyhow::bail!(
+                        "--refine-face: the geometry has no face named `{name}`; its named faces are {}",
+                        names.values().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+                    ),
+                },
+            };
+            if !faces.contains(&face) {
+                anyhow::bail!("--refine-face: the geometry has no face {face}; its faces are {}", face_list(&faces));
             }
-            bounds = bounds.with_face(refine.clone()).map_err(|e| anyhow::anyhow!("--refine-face: {e}"))?;
+            bounds = bounds
+                .with_face(RefineFace { face, max_size: refine.max_size })
+                .map_err(|e| anyhow::anyhow!("--refine-face: {e}"))?;
         }
     }
     let generated =
@@ -368,6 +383,7 @@ where
     let last = &generated.last().expect("at least one step").mesh;
     // The boundary grouped by CAD face, for a solver's boundary conditions.
     let facet_tags = domain.boundary_tags(last);
+    let facet_names = domain.boundary_names();
     let scored = expert.map(|(mesh, path)| WithExpert::new(domain, mesh, &path)).transpose()?;
     let reference = scored.as_ref().map(|p| Reference::new(p, model.limits())).transpose()?;
     let metrics: Vec<Option<MeshMetrics>> = generated
@@ -382,7 +398,7 @@ where
     }
     // Where the final mesh is coarser (> 0) or finer than the expert's, for a viewer.
     let log_ratios = scored.as_ref().map(|p| log_size_ratios(last, &p.expert_mesh));
-    let mut data = MeshData { facet_tags, ..MeshData::new() };
+    let mut data = MeshData { facet_tags, facet_names, ..MeshData::new() };
     if let Some(ratios) = &log_ratios {
         data = data.with_cell("log_size_ratio_to_expert", ratios.clone());
     }
@@ -576,7 +592,8 @@ fn mesh_solid_with(
     let params = Mesh3dParams::default().with_max_elements(args.max_elements);
     let mesh = generate_3d(&surface, field, &params).context("mesh generation failed")?;
     let facet_tags = cad_face_tags(&SurfaceDistance::new(&surface), &mesh);
-    write_output(&mesh, args, MeshData { facet_tags, ..MeshData::new() })?;
+    let facet_names = surface.face_names().clone();
+    write_output(&mesh, args, MeshData { facet_tags, facet_names, ..MeshData::new() })?;
     let report = QualityReport::measure(&mesh, field);
     Ok((mesh, report))
 }
@@ -669,10 +686,12 @@ fn print_faces<const D: usize, P: Domain<D>>(domain: &P) {
     }
     let what = if D == 3 { "area" } else { "length" };
     let point = |p: [f64; D]| p.map(|x| format!("{x:.4}")).join(", ");
+    let names = domain.boundary_names();
     for (tag, face) in faces {
         let centre = face.weighted.map(|x| x / face.measure);
+        let name = names.get(&tag).map_or(String::new(), |name| format!(" `{name}`"));
         println!(
-            "face {tag}: {what} {:.4}, centre ({}), box ({}) to ({})",
+            "face {tag}{name}: {what} {:.4}, centre ({}), box ({}) to ({})",
             face.measure,
             point(centre),
             point(face.lo),
@@ -696,10 +715,30 @@ fn simplex_measure<const D: usize>(corners: &[[f64; D]]) -> f64 {
     }
 }
 
-fn parse_refine_face(text: &str) -> Result<RefineFace, String> {
-    match text.split_once(',').map(|(face, size)| (face.trim().parse::<i32>(), size.trim().parse::<f64>())) {
-        Some((Ok(face), Ok(max_size))) => Ok(RefineFace { face, max_size }),
-        _ => Err(format!("expected FACE,SIZE (a face number and a size, like 3,0.5), got `{text}`")),
+/// A face of `--refine-face`: its number, or the name the geometry gives it.
+#[derive(Clone, Debug, PartialEq)]
+enum FaceArg {
+    Number(i32),
+    Name(String),
+}
+
+/// `--refine-face FACE,SIZE` before its face is looked up in the geometry.
+#[derive(Clone, Debug, PartialEq)]
+struct RefineFaceArg {
+    face: FaceArg,
+    max_size: f64,
+}
+
+fn parse_refine_face(text: &str) -> Result<RefineFaceArg, String> {
+    // The size comes last, so that a face name may hold commas.
+    match text.rsplit_once(',').map(|(face, size)| (face.trim(), size.trim().parse::<f64>())) {
+        Some((face, Ok(max_size))) if !face.is_empty() => {
+            let face = face.parse().map_or_else(|_| FaceArg::Name(face.to_owned()), FaceArg::Number);
+            Ok(RefineFaceArg { face, max_size })
+        }
+        _ => {
+            Err(format!("expected FACE,SIZE (a face number or name and a size, like 3,0.5 or inlet,0.5), got `{text}`"))
+        }
     }
 }
 

@@ -103,6 +103,30 @@ fn meshes_a_solid_to_a_field_given_as_a_tet_mesh() {
     assert!(!output.status.success() && stderr.contains("flat.vtu"), "{stderr}");
 }
 
+/// The names a geometry gives its faces (here an OBJ's groups) name the written mesh's boundary
+/// groups: gmsh physical groups in `.msh`, node sets and surfaces in `.inp`.
+#[test]
+fn names_the_boundary_groups_as_the_geometry_names_its_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("cube.obj");
+    std::fs::write(
+        &cube,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+         g bottom\nf 1 4 3 2\ng top\nf 5 6 7 8\ng side walls\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    let msh = dir.path().join("cube.msh");
+    let output = amber().arg("mesh").arg(&cube).args(["--size", "0.3", "-o"]).arg(&msh).output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let (_, data) = amber_mesh::read_mesh_with_data::<3>(&msh).unwrap();
+    let names: Vec<&str> = data.facet_names.values().map(String::as_str).collect();
+    assert_eq!(names, ["bottom", "top", "side walls"]);
+    let inp = dir.path().join("cube.inp");
+    assert!(amber().arg("mesh").arg(&cube).args(["--size", "0.3", "-o"]).arg(&inp).status().unwrap().success());
+    let text = std::fs::read_to_string(&inp).unwrap();
+    assert!(text.contains("*NSET, NSET=bottom\n") && text.contains("*SURFACE, TYPE=ELEMENT, NAME=\"side walls\"\n"));
+}
+
 /// Several geometries in one command: each meshed to the output with `{stem}` replaced; one
 /// that fails is named, the others are still written, and the command fails.
 #[test]
@@ -392,7 +416,13 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
     let output = mesh_square(&[&fine[..], &["--max-elements", &(elements / 2).to_string()]].concat());
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success() && stderr.contains("--max-elements"), "{elements} elements: {stderr}");
-    for (refine, expected) in [("99,0.02", "its faces are 1–8"), ("1", "FACE,SIZE"), ("1,-0.5", "positive")] {
+    let cases = [
+        ("99,0.02", "its faces are 1–8"),
+        ("1", "FACE,SIZE"),
+        ("1,-0.5", "positive"),
+        ("inlet,0.02", "names no faces"),
+    ];
+    for (refine, expected) in cases {
         let output = mesh_square(&["--refine-face", refine]);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(

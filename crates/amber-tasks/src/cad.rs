@@ -111,6 +111,8 @@ impl Gmsh {
         // Rounded as binary STL stores them, so that the part's STL export (and the Console
         // reference surfaces a model learnt from) give the same surface, and so the same mesh.
         soup.corners.iter_mut().flatten().for_each(|x| *x = f64::from(*x as f32));
+        // gmsh names its solids `Gmsh Surface <id>`, which says no more than the face id.
+        soup.face_names.clear();
         Ok(soup)
     }
 }

@@ -361,7 +361,13 @@ impl FolderDomain<3> for SolidPart {
     fn from_expert(expert: &Expert<3>, initial_size: f64, settings: &DatasetSettings) -> Result<Self, TaskError> {
         let surface = match &expert.geometry {
             Some(path) => read_solid_surface(path, settings.feature_angle(), initial_size)?,
-            None => solid_surface_of_mesh(&expert.path, &expert.mesh, &expert.facet_tags, settings.feature_angle())?,
+            None => solid_surface_of_mesh(
+                &expert.path,
+                &expert.mesh,
+                &expert.facet_tags,
+                BTreeMap::new(),
+                settings.feature_angle(),
+            )?,
         };
         let bounds = amber_mesh::bounding_box(surface.vertices()).expect("a validated surface has vertices");
         check_geometry(expert, bounds, surface.enclosed_volume())?;

@@ -44,10 +44,12 @@ pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) ->
         Some(soup) => {
             let surface =
                 Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(|e| geometry(e.to_string()))?;
-            validated_solid(path, surface, feature_angle)
+            validated_solid(path, surface.with_face_names(soup.face_names), feature_angle)
         }
         None => match read_any_mesh(path).map_err(|e| unreadable(path, e, "neither a surface nor a tet mesh: "))? {
-            AnyMesh::Three(mesh, data) => solid_surface_of_mesh(path, &mesh, &data.facet_tags, feature_angle),
+            AnyMesh::Three(mesh, data) => {
+                solid_surface_of_mesh(path, &mesh, &data.facet_tags, data.facet_names, feature_angle)
+            }
             AnyMesh::Two(..) => Err(geometry("holds triangles (a 2D geometry), not a solid".into())),
         },
     }
@@ -63,17 +65,18 @@ fn unreadable(path: &Path, error: MeshError, expected: &str) -> TaskError {
 }
 
 /// The boundary of the tet mesh `mesh` (read from `path`) as a validated surface, its faces the
-/// file's `facet_tags` (physical groups, skin properties) when they name more than one, else
-/// split at edges sharper than `feature_angle` degrees.
+/// file's `facet_tags` (physical groups, skin properties) named by `facet_names` when they name
+/// more than one, else split at edges sharper than `feature_angle` degrees.
 pub(crate) fn solid_surface_of_mesh(
     path: &Path,
     mesh: &Mesh3,
     facet_tags: &BTreeMap<Vec<u32>, i32>,
+    facet_names: BTreeMap<i32, String>,
     feature_angle: f64,
 ) -> Result<Surface, TaskError> {
     let surface = Surface::from_mesh_boundary(mesh, facet_tags)
         .map_err(|e| TaskError::Geometry { path: path.into(), message: format!("boundary of the tet mesh: {e}") })?;
-    validated_solid(path, surface, feature_angle)
+    validated_solid(path, surface.with_face_names(facet_names), feature_angle)
 }
 
 /// `surface` (from `path`) split at feature edges when it has a single face, and validated.
@@ -295,6 +298,10 @@ impl Domain<3> for SolidPart {
     fn boundary_tags(&self, mesh: &Mesh<3>) -> BTreeMap<Vec<u32>, i32> {
         cad_face_tags(&self.distance, mesh)
     }
+
+    fn boundary_names(&self) -> BTreeMap<i32, String> {
+        self.surface.face_names().clone()
+    }
 }
 
 /// Every boundary triangle of `mesh` (a mesh of the solid `distance` measures), keyed by its
@@ -492,7 +499,8 @@ mod tests {
         let facet_tags = part.boundary_tags(mesh).into_iter().map(|(facet, face)| (facet, group(face))).collect();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("cube.msh");
-        amber_mesh::write_mesh(mesh, &path, &amber_mesh::MeshData { facet_tags, ..Default::default() }).unwrap();
+        let data = amber_mesh::MeshData { facet_tags, ..Default::default() }.with_facet_name(7, "ends");
+        amber_mesh::write_mesh(mesh, &path, &data).unwrap();
 
         let surface = read_solid_surface(&path, FEATURE_ANGLE_DEGREES, 0.3).unwrap();
         let on_a_z_side = |t: &[u32; 3]| {
@@ -502,9 +510,13 @@ mod tests {
         for (t, &face) in surface.triangles().iter().zip(surface.face_ids()) {
             assert_eq!(face, if on_a_z_side(t) { 7 } else { 3 }, "{t:?}");
         }
+        // The named group keeps its name; the other gets the writer's.
+        let names = BTreeMap::from([(3, "boundary_3".into()), (7, "ends".into())]);
+        assert_eq!(surface.face_names(), &names);
         let remeshed = SolidPart::new("cube".into(), surface, 0.3).unwrap();
         let tags = remeshed.boundary_tags(&remeshed.initial_mesh);
         assert_eq!(tags.values().copied().collect::<std::collections::BTreeSet<_>>(), [3, 7].into());
+        assert_eq!(remeshed.boundary_names(), names);
     }
 
     /// Every element of an L-shaped plate gets the geometry inputs, no element is farther from

@@ -72,6 +72,11 @@ pub trait Domain<const D: usize>: Sync {
     fn boundary_tags(&self, _mesh: &Mesh<D>) -> BTreeMap<Vec<u32>, i32> {
         BTreeMap::new()
     }
+    /// The names of the tags of [`Domain::boundary_tags`] where the geometry gives them (a
+    /// mesh file's physical groups, an STL's solids, an OBJ's groups).
+    fn boundary_names(&self) -> BTreeMap<i32, String> {
+        BTreeMap::new()
+    }
 }
 
 /// One problem of a learning task in `D` dimensions: a domain with the expert's mesh of it.
@@ -126,6 +131,10 @@ impl<const D: usize, P: Domain<D>> Domain<D> for WithExpert<P, D> {
 
     fn boundary_tags(&self, mesh: &Mesh<D>) -> BTreeMap<Vec<u32>, i32> {
         self.domain.boundary_tags(mesh)
+    }
+
+    fn boundary_names(&self) -> BTreeMap<i32, String> {
+        self.domain.boundary_names()
     }
 }
 

@@ -175,12 +175,34 @@ pub(super) fn write<const D: usize>(
             groups.entry(tag).or_default().push(side);
         }
     }
-    write_body(nodes, &groups, w).map_err(write_error(path))
+    let names = groups
+        .keys()
+        .map(|&tag| abaqus_label(&data.group_name(tag, groups.len())).map(|label| (tag, label)))
+        .collect::<Result<BTreeMap<i32, String>, String>>()
+        .map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
+    write_body(nodes, &groups, &names, w).map_err(write_error(path))
+}
+
+/// `name` as an Abaqus set or surface name: as it is when it is a plain label (a letter, then
+/// letters, digits and underscores), else in double quotes, which Abaqus needs around spaces
+/// and other characters; an error for what a quoted name cannot hold.
+fn abaqus_label(name: &str) -> Result<String, String> {
+    let plain = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    let label = if plain { name.to_owned() } else { format!("\"{name}\"") };
+    if name.is_empty() || name.contains(['"', '\n', '\r']) || label.chars().count() > 80 {
+        Err(format!(
+            "facet group name {name:?} cannot be an Abaqus set name (at most 80 characters with its quotes, no quotes or line breaks)"
+        ))
+    } else {
+        Ok(label)
+    }
 }
 
 fn write_body<const D: usize>(
     nodes: &Nodes<D>,
     groups: &BTreeMap<i32, Vec<(usize, usize)>>,
+    names: &BTreeMap<i32, String>,
     w: &mut impl Write,
 ) -> std::io::Result<()> {
     let mesh = nodes.mesh();
@@ -207,7 +229,7 @@ fn write_body<const D: usize>(
         writeln!(w)?;
     }
     for (tag, sides) in groups {
-        let name = if groups.len() == 1 { "boundary".to_owned() } else { format!("boundary_{tag}").replace('-', "m") };
+        let name = &names[tag];
         // Every node on the group's faces, edge nodes too: a boundary condition holds them all.
         let mut on_faces: Vec<u32> = sides
             .iter()
@@ -278,18 +300,30 @@ mod tests {
     #[test]
     fn writes_a_node_set_and_a_surface_per_facet_tag() {
         let tet =
-            crate::Mesh3::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3]);
-        let data =
-            MeshData::new().with_facet_tag([0, 1, 2], 5).with_facet_tag([0, 3, 1], 7).with_facet_tag([1, 3, 2], 7);
+            crate::Mesh3::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3])
+                .unwrap();
+        let tet = Nodes::new(&tet, ElementOrder::Linear);
+        let data = MeshData::new()
+            .with_facet_tag([0, 1, 2], 5)
+            .with_facet_tag([0, 3, 1], 7)
+            .with_facet_tag([1, 3, 2], 7)
+            .with_facet_name(5, "outlet")
+            .with_facet_name(7, "inlet wall");
         let mut bytes = Vec::new();
-        write(&Nodes::new(&tet.unwrap(), ElementOrder::Linear), &data, &mut bytes, Path::new("x.inp")).unwrap();
+        write(&tet, &data, &mut bytes, Path::new("x.inp")).unwrap();
         let text = std::str::from_utf8(&bytes).unwrap();
         let groups = text.split_once("*NSET").unwrap().1;
         assert_eq!(
             groups,
-            ", NSET=boundary_5\n1, 2, 3\n*SURFACE, TYPE=ELEMENT, NAME=boundary_5\n1, S1\n\
-             *NSET, NSET=boundary_7\n1, 2, 3, 4\n*SURFACE, TYPE=ELEMENT, NAME=boundary_7\n1, S3\n1, S2\n\
+            ", NSET=outlet\n1, 2, 3\n*SURFACE, TYPE=ELEMENT, NAME=outlet\n1, S1\n\
+             *NSET, NSET=\"inlet wall\"\n1, 2, 3, 4\n*SURFACE, TYPE=ELEMENT, NAME=\"inlet wall\"\n1, S3\n1, S2\n\
              *NSET, NSET=boundary_8\n1, 3, 4\n*SURFACE, TYPE=ELEMENT, NAME=boundary_8\n1, S4\n"
         );
+        let mut quoted = data.with_facet_name(8, "a \"b\"");
+        let err = write(&tet, &quoted, &mut bytes, Path::new("x.inp"));
+        assert!(err.unwrap_err().to_string().contains("x.inp"));
+        quoted.facet_names.insert(8, "n".repeat(81));
+        let err = write(&tet, &quoted, &mut bytes, Path::new("x.inp"));
+        assert!(err.unwrap_err().to_string().contains("at most 80 characters"));
     }
 }

@@ -36,8 +36,8 @@ use crate::{Mesh, Mesh2, Mesh3, MeshError};
 /// or per vertex (`point`), tags on boundary facets, and what a reader left out.
 ///
 /// `.vtu`, `.vtk`, `.msh` and `.json` store the fields; `.nas`, `.inp` and `.mesh` none. `.msh`
-/// and `.mesh` store the facet tags; `.inp` writes them as node sets and element-side surfaces,
-/// and `.nas` (3D) as skin triangles under one property per tag.
+/// and `.mesh` store the facet tags (`.msh` with their names); `.inp` writes them as named node
+/// sets and element-side surfaces, and `.nas` (3D) as skin triangles under one property per tag.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {
     /// Per-element fields, by name.
@@ -50,6 +50,10 @@ pub struct MeshData {
     /// physical group per tag (tags must be positive); without tags it writes one group for the
     /// whole boundary.
     pub facet_tags: BTreeMap<Vec<u32>, i32>,
+    /// Names of facet tags (gmsh's `$PhysicalNames`), which the `.msh` and `.inp` writers give
+    /// their boundary groups: a solver setup refers to `inlet`, not to tag 7. A tag without a
+    /// name is written as `boundary_<tag>` (`boundary` when it is the only group).
+    pub facet_names: BTreeMap<i32, String>,
     /// Elements a reader dropped because they are neither simplices of the mesh dimension nor
     /// tagged facets (those are in `facet_tags`), counted by kind (`line`, `quad`, `hexahedron`,
     /// ...). Writers ignore it.
@@ -84,6 +88,22 @@ impl MeshData {
         facet.sort_unstable();
         self.facet_tags.insert(facet, tag);
         self
+    }
+
+    /// Adds (or replaces) the name of the facets tagged `tag`.
+    pub fn with_facet_name(mut self, tag: i32, name: impl Into<String>) -> Self {
+        self.facet_names.insert(tag, name.into());
+        self
+    }
+
+    /// The name the writers give the boundary group of `tag`, one of `groups`: its name in
+    /// [`MeshData::facet_names`], else `boundary` for a lone group and `boundary_<tag>` otherwise.
+    fn group_name(&self, tag: i32, groups: usize) -> String {
+        match self.facet_names.get(&tag) {
+            Some(name) => name.clone(),
+            None if groups == 1 => "boundary".to_owned(),
+            None => format!("boundary_{tag}"),
+        }
     }
 
     /// Whether there are no fields and no facet tags.
@@ -246,6 +266,9 @@ pub struct TriangleSoup {
     /// The face id of every triangle: from the STL file as `stl_face_ids` says, or the 1-based
     /// `g`/`o` group of an OBJ file in order of appearance.
     pub face_ids: Vec<i32>,
+    /// The names of face ids where the file gives them: an ASCII STL's `solid NAME` blocks (with
+    /// face ids from the file), an OBJ file's groups.
+    pub face_names: BTreeMap<i32, String>,
 }
 
 const SURFACE_FORMATS: &str = ".stl, .obj";
@@ -667,7 +690,11 @@ mod tests {
         let soup = read_surface(&path, StlFaceIds::FromFile).unwrap();
         assert_eq!(
             soup,
-            TriangleSoup { corners: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], face_ids: vec![1] }
+            TriangleSoup {
+                corners: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                face_ids: vec![1],
+                face_names: BTreeMap::new()
+            }
         );
         let bad = dir.join("bad.obj");
         std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap();

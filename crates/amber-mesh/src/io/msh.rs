@@ -197,6 +197,7 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                 &mut element_tags,
                 &mut element_nodes,
             )?,
+            "PhysicalNames" => read_physical_names(&mut body, &mut raw.tag_names)?,
             "NodeData" | "ElementData" => sections.extend(read_data(&mut body, name == "ElementData")?),
             _ => {
                 let end = format!("$End{name}");
@@ -239,6 +240,26 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
         };
     }
     Ok(raw)
+}
+
+/// Reads `$PhysicalNames` (text in binary files too): `dimension tag "name"` per line.
+fn read_physical_names(body: &mut Body, names: &mut Vec<(usize, i32, String)>) -> Result<(), MeshError> {
+    let n: u64 = body.c.parse("number of physical names")?;
+    // The shortest line is `1 1 ""` and its line ending.
+    for _ in 0..body.c.bound(n, 7, "physical names")? {
+        let dim: usize = body.c.parse("physical group dimension")?;
+        let tag: i32 = body.c.parse("physical group tag")?;
+        let line_start = body.c.pos;
+        let line = body.c.expect_line("a physical name")?.trim();
+        match line.strip_prefix('"').and_then(|l| l.strip_suffix('"')) {
+            Some(name) => names.push((dim, tag, name.to_owned())),
+            None => {
+                body.c.pos = line_start;
+                return Err(body.c.error(format!("physical name `{line}` is not in double quotes")));
+            }
+        }
+    }
+    body.end("PhysicalNames")
 }
 
 /// Reads `$Entities` (4.1): the physical group (the first, if several) of every entity.
@@ -475,11 +496,12 @@ pub(super) fn write<const D: usize>(
     w: &mut impl Write,
     path: &Path,
 ) -> Result<(), MeshError> {
-    for name in data.cell.keys().chain(data.point.keys()) {
+    let names = data.cell.keys().chain(data.point.keys()).map(|n| ("field", n));
+    for (what, name) in names.chain(data.facet_names.values().map(|n| ("facet group name", n))) {
         if name.contains(['"', '\n', '\r']) {
             return Err(MeshError::Format {
                 path: path.to_owned(),
-                message: format!("field name {name:?} cannot be stored in a .msh string tag"),
+                message: format!("{what} {name:?} cannot be stored in a .msh string"),
             });
         }
     }
@@ -513,8 +535,7 @@ fn write_body<const D: usize, W: Write>(
     out.line("$PhysicalNames")?;
     out.line(&format!("{}\n{D} 1 \"domain\"", groups.len() + 1))?;
     for &tag in groups.keys() {
-        let name = if groups.len() == 1 { "boundary".to_owned() } else { format!("boundary_{tag}") };
-        out.line(&format!("{} {tag} \"{name}\"", D - 1))?;
+        out.line(&format!("{} {tag} \"{}\"", D - 1, data.group_name(tag, groups.len())))?;
     }
     out.line("$EndPhysicalNames")?;
 
@@ -717,7 +738,8 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
         let data = MeshData::new()
             .with_cell("h", vec![f64::NAN])
             .with_point("u", vec![5e-324, 1e300, -2.5, -0.0])
-            .with_facet_tag([0, 1, 2], 3);
+            .with_facet_tag([0, 1, 2], 3)
+            .with_facet_name(3, "inlet wall");
         for binary in [false, true] {
             let bytes = written(&mesh, &data, binary);
             let path = Path::new("x.msh");
@@ -729,7 +751,19 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
             assert_eq!(back_data.facet_tags.len(), 4);
             assert_eq!(back_data.facet_tags[&vec![0, 1, 2]], 3);
             assert_eq!(back_data.facet_tags.values().filter(|&&t| t == 4).count(), 3);
+            assert_eq!(back_data.facet_names, BTreeMap::from([(3, "inlet wall".into()), (4, "boundary_4".into())]));
         }
+        let linear = Nodes::new(&mesh, ElementOrder::Linear);
+        let quoted = data.with_facet_name(3, "say \"hi\"");
+        let err = write(&linear, &quoted, false, &mut Vec::new(), Path::new("x.msh")).unwrap_err().to_string();
+        assert!(err.contains("facet group name") && err.contains("x.msh"), "{err}");
+    }
+
+    #[test]
+    fn physical_names_must_be_quoted() {
+        let text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 5 inlet\n$EndPhysicalNames\n";
+        let err = read(Path::new("x.msh"), text.as_bytes()).err().unwrap().to_string();
+        assert!(err.contains("x.msh:6:") && err.contains("`inlet` is not in double quotes"), "{err}");
     }
 
     #[test]

@@ -37,7 +37,8 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, MeshError>
             _ => {}
         }
     }
-    Ok(TriangleSoup { corners, face_ids: ids })
+    let face_names = group_ids.into_iter().filter(|(name, _)| !name.is_empty()).map(|(name, id)| (id, name)).collect();
+    Ok(TriangleSoup { corners, face_ids: ids, face_names })
 }
 
 /// A face corner `v`, `v/vt`, `v//vn` or `v/vt/vn`; 1-based, negative counts back from the end.
@@ -67,6 +68,8 @@ pub(super) mod tests {
         let soup = read(Path::new("cube.obj"), CUBE_OBJ.as_bytes()).unwrap();
         assert_eq!(soup.corners.len(), 36);
         assert_eq!(soup.face_ids, [1, 1, 2, 2, 3, 3, 3, 3, 3, 3, 3, 3]);
+        let names = soup.face_names.values().map(String::as_str).collect::<Vec<_>>();
+        assert_eq!(names, ["bottom", "top", "sides"]);
         let [v1, v2, v3, v4, v5, _, _, v8] = [
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],

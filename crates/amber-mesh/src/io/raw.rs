@@ -71,6 +71,8 @@ pub(super) struct RawMesh {
     /// A tag per cell (gmsh physical group, medit reference, 0 for none), or empty when the
     /// format has none.
     pub(super) tags: Vec<i32>,
+    /// Names of tags by dimension and tag (gmsh's `$PhysicalNames`).
+    pub(super) tag_names: Vec<(usize, i32, String)>,
     /// Per-cell fields over all cells, in file order.
     pub(super) cell_data: BTreeMap<String, Vec<f64>>,
     pub(super) point_data: BTreeMap<String, Vec<f64>>,
@@ -96,7 +98,8 @@ impl RawMesh {
     /// highest cell dimension is not `D` (so a caller can try the other), keeps the
     /// `D`-simplices with their cell data (a quadratic one as the linear simplex of its corners,
     /// counted in [`MeshData::linearised`]), records tagged `(D-1)`-simplices as facet tags and
-    /// counts every other cell (untagged facets among them) in [`MeshData::dropped`].
+    /// counts every other cell (untagged facets among them) in [`MeshData::dropped`]; the names
+    /// of the `(D-1)`-dimensional tags some facet carries become [`MeshData::facet_names`].
     pub(super) fn finish<const D: usize>(self, path: &Path) -> Result<(Mesh<D>, MeshData), MeshError> {
         let found = self.dimension();
         if found != D {
@@ -140,6 +143,11 @@ impl RawMesh {
                 *data.dropped.entry(kind.name.to_owned()).or_default() += 1;
             }
         }
+        let used: std::collections::BTreeSet<i32> = data.facet_tags.values().copied().collect();
+        data.facet_names = (self.tag_names.into_iter())
+            .filter(|(dim, tag, _)| dim + 1 == D && used.contains(tag))
+            .map(|(_, tag, name)| (tag, name))
+            .collect();
         for (name, values) in self.cell_data {
             if values.len() != self.kinds.len() {
                 let field = format!("element field `{name}`");
@@ -173,12 +181,14 @@ mod tests {
         raw.push_cell(Kind { dim: 2, name: "quad" }, [0, 1, 3, 2]);
         raw.push_cell(Kind::VERTEX, [3]);
         raw.tags = vec![7, 1, 1, 0];
+        raw.tag_names = vec![(1, 7, "inlet".into()), (1, 8, "unused".into()), (2, 7, "domain".into())];
         raw.cell_data.insert("h".into(), vec![0.0, 1.0, 2.0, 3.0]);
         let (mesh, data) = raw.finish::<2>(Path::new("x")).unwrap();
         assert_eq!(mesh.num_elements(), 1);
         assert_eq!(data.cell["h"], vec![1.0]);
         assert_eq!(data.dropped, BTreeMap::from([("quad".into(), 1), ("vertex".into(), 1)]));
         assert_eq!(data.facet_tags, BTreeMap::from([(vec![0, 1], 7)]));
+        assert_eq!(data.facet_names, BTreeMap::from([(7, "inlet".into())]));
         let raw = RawMesh { points: vec![[0.0; 3]], kinds: vec![Kind::LINE], ..Default::default() };
         let err = raw.finish::<2>(Path::new("x")).unwrap_err();
         assert!(matches!(err, MeshError::DimensionMismatch { found: 1, .. }), "{err}");

@@ -3,6 +3,7 @@
 //! The per-facet normals are skipped; face ids come from the binary facet attribute or the
 //! ASCII `solid` block, or are all 1 ([`StlFaceIds`]).
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::{StlFaceIds, TriangleSoup, parse_point};
@@ -42,19 +43,26 @@ fn read_binary(facets: &[u8], n: usize, face_ids: StlFaceIds) -> TriangleSoup {
             StlFaceIds::Single => 1,
         });
     }
-    TriangleSoup { corners, face_ids: ids }
+    TriangleSoup { corners, face_ids: ids, face_names: BTreeMap::new() }
 }
 
 fn read_ascii(path: &Path, text: &str, face_ids: StlFaceIds) -> Result<TriangleSoup, MeshError> {
     let mut corners = Vec::new();
     let mut ids = Vec::new();
     let mut solid = 0;
+    let mut face_names = BTreeMap::new();
     let mut facet: Vec<[f64; 3]> = Vec::with_capacity(3);
     for (number, line) in text.lines().enumerate() {
         let at = |message| MeshError::Parse { path: path.to_owned(), line: number + 1, message };
         let mut words = line.split_whitespace();
         match words.next() {
-            Some("solid") => solid += 1,
+            Some("solid") => {
+                solid += 1;
+                let name = words.collect::<Vec<_>>().join(" ");
+                if face_ids == StlFaceIds::FromFile && !name.is_empty() {
+                    face_names.insert(solid, name);
+                }
+            }
             Some("facet") => facet.clear(),
             Some("vertex") => facet.push(parse_point(words).map_err(at)?),
             Some("endfacet") => {
@@ -67,7 +75,7 @@ fn read_ascii(path: &Path, text: &str, face_ids: StlFaceIds) -> Result<TriangleS
             _ => {}
         }
     }
-    Ok(TriangleSoup { corners, face_ids: ids })
+    Ok(TriangleSoup { corners, face_ids: ids, face_names })
 }
 
 #[cfg(test)]
@@ -96,7 +104,10 @@ mod tests {
         let attributes: Vec<u16> = (0..12).map(|t| t / 2 + 1).collect();
         let soup = read(path, &binary_stl(&corners, &attributes), StlFaceIds::FromFile).unwrap();
         let expected_ids: Vec<i32> = attributes.iter().map(|&a| a as i32).collect();
-        assert_eq!(soup, TriangleSoup { corners: corners.clone(), face_ids: expected_ids });
+        assert_eq!(
+            soup,
+            TriangleSoup { corners: corners.clone(), face_ids: expected_ids, face_names: BTreeMap::new() }
+        );
         let single = read(path, &binary_stl(&corners, &attributes), StlFaceIds::Single).unwrap();
         assert!(single.face_ids.iter().all(|&i| i == 1));
         let mut ascii = String::from("solid a\n");
@@ -112,6 +123,8 @@ mod tests {
         let soup = read(path, ascii.as_bytes(), StlFaceIds::FromFile).unwrap();
         assert_eq!(soup.corners, corners);
         assert_eq!(soup.face_ids, [1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2]);
+        assert_eq!(soup.face_names, BTreeMap::from([(1, "a".into()), (2, "b".into())]));
+        assert!(read(path, ascii.as_bytes(), StlFaceIds::Single).unwrap().face_names.is_empty());
     }
 
     #[test]

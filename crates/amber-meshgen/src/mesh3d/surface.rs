@@ -27,6 +27,8 @@ pub struct Surface {
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
     face_ids: Vec<i32>,
+    /// Names of face ids, where the geometry gives them.
+    face_names: BTreeMap<i32, String>,
     /// Whether [`Surface::validate`] succeeded (nothing can change the surface afterwards).
     valid: bool,
 }
@@ -147,7 +149,7 @@ impl Surface {
                 });
             }
         }
-        Ok(Self { vertices, triangles, face_ids, valid: false })
+        Ok(Self { vertices, triangles, face_ids, face_names: BTreeMap::new(), valid: false })
     }
 
     /// Builds a surface from a triangle soup (3 corners per triangle, as in STL), merging
@@ -178,7 +180,9 @@ impl Surface {
         let path = path.as_ref();
         let soup = read_surface(path, stl_face_ids)?;
         let defect = |source| SurfaceError::Defect { path: path.into(), source };
-        let mut surface = Self::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(defect)?;
+        let mut surface = Self::from_triangle_soup(&soup.corners, soup.face_ids, 0.0)
+            .map_err(defect)?
+            .with_face_names(soup.face_names);
         let report = surface.validate().map_err(defect)?;
         Ok((surface, report))
     }
@@ -220,7 +224,7 @@ impl Surface {
     /// Splits the faces at feature edges, for surfaces whose files carry no CAD faces: two
     /// triangles across an edge stay in one face when they were in one face and their normals
     /// differ by at most `angle_degrees`. Faces are renumbered from 1 in the order of their first
-    /// triangle. The surface must be validated again.
+    /// triangle, without names. The surface must be validated again.
     pub fn split_faces_at_feature_edges(&mut self, angle_degrees: f64) {
         let normal = |t: &[u32; 3]| {
             let p = |k: usize| Vector3::from(self.vertices[t[k] as usize]);
@@ -255,6 +259,7 @@ impl Surface {
             }
         }
         self.face_ids = face;
+        self.face_names.clear();
         self.valid = false;
     }
 
@@ -306,6 +311,18 @@ impl Surface {
     /// CAD face id of every triangle.
     pub fn face_ids(&self) -> &[i32] {
         &self.face_ids
+    }
+
+    /// The surface with these names of its face ids (a file's STL solids, OBJ groups, gmsh
+    /// physical groups), which meshes of it give their boundary groups.
+    pub fn with_face_names(mut self, names: BTreeMap<i32, String>) -> Self {
+        self.face_names = names;
+        self
+    }
+
+    /// Names of face ids, where the geometry gives them.
+    pub fn face_names(&self) -> &BTreeMap<i32, String> {
+        &self.face_names
     }
 
     /// Signed enclosed volume (divergence theorem; positive for a closed outward surface).
