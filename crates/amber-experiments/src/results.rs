@@ -111,8 +111,32 @@ pub struct RunResult {
     pub failed_steps: usize,
     pub train_seconds: f64,
     pub eval_seconds: f64,
+    /// The threads behind those times (absent in runs recorded before they were kept).
+    #[serde(default)]
+    pub threads: RunThreads,
     /// Every test problem's rollout: the values the means above reduce.
     pub problems: Vec<ProblemEvaluation>,
+}
+
+/// The threads (rayon's pool) a run trained with, in its last session, and was evaluated with:
+/// its wall times, and on more than one thread its bits, depend on them. `None` where a run was
+/// recorded before runs kept them, or where a cross-validation's folds differ.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RunThreads {
+    pub train: Option<usize>,
+    pub eval: Option<usize>,
+}
+
+impl RunThreads {
+    /// What the threads of several runs (a cross-validation's folds) have in common.
+    pub fn common(all: impl IntoIterator<Item = RunThreads>) -> Self {
+        let mut all = all.into_iter();
+        let first = all.next().unwrap_or_default();
+        all.fold(first, |common, next| RunThreads {
+            train: common.train.filter(|_| common.train == next.train),
+            eval: common.eval.filter(|_| common.eval == next.eval),
+        })
+    }
 }
 
 /// Where a run result came from, apart from its evaluations.
@@ -123,6 +147,7 @@ pub struct RunKey<'a> {
     pub seed: usize,
     pub train_seconds: f64,
     pub eval_seconds: f64,
+    pub threads: RunThreads,
 }
 
 impl RunResult {
@@ -160,6 +185,7 @@ impl RunResult {
                 .count(),
             train_seconds: key.train_seconds,
             eval_seconds: key.eval_seconds,
+            threads: key.threads,
             problems: problems.to_vec(),
         }
     }
@@ -254,14 +280,29 @@ mod tests {
     #[test]
     fn runs_reduce_to_means_quantiles_and_failure_counts() {
         let problems = [evaluation(&[0.8, 0.4], false), evaluation(&[0.6, 0.2], true), evaluation(&[0.7, 0.3], false)];
-        let key =
-            RunKey { method: "m", variant: "v", difficulty: "hard", seed: 0, train_seconds: 1.0, eval_seconds: 2.0 };
+        let key = RunKey {
+            method: "m",
+            variant: "v",
+            difficulty: "hard",
+            seed: 0,
+            train_seconds: 1.0,
+            eval_seconds: 2.0,
+            threads: RunThreads::default(),
+        };
         let run = RunResult::new(key, &problems);
         assert!((run.ndcd - 0.3).abs() < 1e-12);
         assert!((run.ndcd_per_step[0] - 0.7).abs() < 1e-12 && (run.ndcd_per_step[1] - 0.3).abs() < 1e-12);
         assert!((run.ndcd_quantiles[0] - 0.25).abs() < 1e-12 && (run.ndcd_quantiles[1] - 0.35).abs() < 1e-12);
         assert_eq!(run.failed_steps, 1);
         assert_eq!((run.test_problems, run.expert_elements), (3, 20.0));
+    }
+
+    #[test]
+    fn folds_share_the_threads_they_agree_on() {
+        let threads = |train, eval| RunThreads { train: Some(train), eval: Some(eval) };
+        let common = RunThreads::common([threads(1, 2), threads(1, 1), threads(1, 2)]);
+        assert_eq!(common, RunThreads { train: Some(1), eval: None });
+        assert_eq!(RunThreads::common([]), RunThreads::default());
     }
 
     #[test]

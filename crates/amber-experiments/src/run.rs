@@ -21,7 +21,7 @@ use crate::method::MethodSpec;
 use crate::profiles::Task;
 use crate::progress::TrainingProgress;
 use crate::report::{commit, config_hash, write_json};
-use crate::results::{ProblemEvaluation, RunKey, RunResult};
+use crate::results::{ProblemEvaluation, RunKey, RunResult, RunThreads};
 
 /// Test problems whose rollouts are kept as meshes (`.vtu`) and drawn in the gallery.
 pub(crate) const GALLERY_PROBLEMS: usize = 2;
@@ -41,6 +41,8 @@ pub(crate) struct CachedEvaluation {
     pub test_set: String,
     pub train_seconds: f64,
     pub eval_seconds: f64,
+    #[serde(default)]
+    pub threads: RunThreads,
     pub problems: Vec<ProblemEvaluation>,
 }
 
@@ -52,6 +54,7 @@ impl CachedEvaluation {
             test_set: folds.iter().map(|f| f.test_set.as_str()).collect::<Vec<_>>().join("; "),
             train_seconds: folds.iter().map(|f| f.train_seconds).sum(),
             eval_seconds: folds.iter().map(|f| f.eval_seconds).sum(),
+            threads: RunThreads::common(folds.iter().map(|f| f.threads)),
             problems: folds.into_iter().flat_map(|f| f.problems).collect(),
         }
     }
@@ -65,6 +68,7 @@ impl CachedEvaluation {
             seed,
             train_seconds: self.train_seconds,
             eval_seconds: self.eval_seconds,
+            threads: self.threads,
         };
         RunResult::new(key, &self.problems)
     }
@@ -181,7 +185,9 @@ impl Run {
             test.len(),
             eval_seconds
         );
-        let evaluated = CachedEvaluation { test_set: self.test_name.clone(), train_seconds, eval_seconds, problems };
+        let threads = RunThreads { train: self.training_record()?.threads, eval: Some(rayon::current_num_threads()) };
+        let evaluated =
+            CachedEvaluation { test_set: self.test_name.clone(), train_seconds, eval_seconds, threads, problems };
         write_json(&cache, &evaluated)?;
         self.write_card(&evaluated)?;
         Ok(evaluated)
@@ -195,8 +201,7 @@ impl Run {
         if !model.is_dir() {
             return Ok(());
         }
-        let record_path = self.dir.join(TIME_FILE);
-        let record: TrainingRecord = if record_path.exists() { read_json(&record_path)? } else { Default::default() };
+        let record = self.training_record()?;
         let key = RunKey {
             method: &self.card.method,
             variant: "",
@@ -204,6 +209,7 @@ impl Run {
             seed: 0,
             train_seconds: evaluated.train_seconds,
             eval_seconds: evaluated.eval_seconds,
+            threads: evaluated.threads,
         };
         let result = RunResult::new(key, &evaluated.problems);
         let card = ModelCard {
@@ -214,6 +220,12 @@ impl Run {
             ..self.card.clone()
         };
         card.write(&model)
+    }
+
+    /// What the run directory records of its training (nothing before it trained).
+    fn training_record(&self) -> anyhow::Result<TrainingRecord> {
+        let path = self.dir.join(TIME_FILE);
+        Ok(if path.exists() { read_json(&path)? } else { TrainingRecord::default() })
     }
 
     fn gallery_path(&self, problem: usize, step: usize) -> PathBuf {
@@ -290,6 +302,9 @@ struct TrainingRecord {
     command: Option<String>,
     #[serde(default)]
     commit: Option<String>,
+    /// The threads of the last session (absent in runs trained before they were recorded).
+    #[serde(default)]
+    threads: Option<usize>,
 }
 
 impl TrainingRecord {
@@ -299,6 +314,7 @@ impl TrainingRecord {
             finished,
             command: Some(std::env::args().collect::<Vec<_>>().join(" ")),
             commit: Some(commit().to_owned()),
+            threads: Some(rayon::current_num_threads()),
         }
     }
 }

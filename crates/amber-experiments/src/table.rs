@@ -178,6 +178,7 @@ mod tests {
             seed,
             train_seconds: 0.0,
             eval_seconds: 0.0,
+            threads: Default::default(),
         };
         let first = RunResult::new(key(0), &[problem(90, 100), problem(300, 200)]);
         let second = RunResult::new(key(1), &[problem(50, 100)]);

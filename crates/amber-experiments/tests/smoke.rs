@@ -66,6 +66,8 @@ fn smoke_profile_writes_every_output_and_reuses_its_runs() {
         // d(M̂) < d(M⁰): the normalisation is well defined.
         assert!(run["dcd_reconstruction"].as_f64().unwrap() < run["dcd_initial"].as_f64().unwrap(), "{run}");
         assert!(run["train_seconds"].as_f64().unwrap() > 0.0);
+        let threads = rayon::current_num_threads();
+        assert_eq!(run["threads"], serde_json::json!({ "train": threads, "eval": threads }), "{run}");
     }
     let methods: Vec<&str> = runs.iter().map(|r| r["method"].as_str().unwrap()).collect();
     assert_eq!(methods, ["amber-mean", "amber-max", "cnn-32"]);
