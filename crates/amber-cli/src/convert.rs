@@ -72,6 +72,10 @@ fn write<const D: usize>(
         data.point.len(),
         data.facet_tags.len()
     );
+    if !data.facet_names.is_empty() {
+        let names: Vec<String> = data.facet_names.iter().map(|(tag, name)| format!("{tag} `{name}`")).collect();
+        summary += &format!(" (named: {})", names.join(", "));
+    }
     if !data.linearised.is_empty() {
         let linearised: Vec<String> = data.linearised.iter().map(|(kind, n)| format!("{n} {kind}")).collect();
         summary += &format!("; read by their corner nodes: {}", linearised.join(", "));

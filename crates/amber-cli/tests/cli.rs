@@ -125,6 +125,10 @@ fn names_the_boundary_groups_as_the_geometry_names_its_faces() {
     assert!(amber().arg("mesh").arg(&cube).args(["--size", "0.3", "-o"]).arg(&inp).status().unwrap().success());
     let text = std::fs::read_to_string(&inp).unwrap();
     assert!(text.contains("*NSET, NSET=bottom\n") && text.contains("*SURFACE, TYPE=ELEMENT, NAME=\"side walls\"\n"));
+    // `amber convert` carries the names from format to format.
+    let converted = dir.path().join("converted.inp");
+    assert!(amber().arg("convert").arg(&msh).arg(&converted).status().unwrap().success());
+    assert!(std::fs::read_to_string(&converted).unwrap().contains("*NSET, NSET=top\n"));
 }
 
 /// Several geometries in one command: each meshed to the output with `{stem}` replaced; one
@@ -177,7 +181,7 @@ fn converts_between_formats_in_the_dimension_of_the_file() {
     assert!(output.status.success());
     let summary = String::from_utf8_lossy(&output.stderr);
     assert!(
-        summary.contains("4 tagged facets") && !summary.contains("dropped"),
+        summary.contains("4 tagged facets (named: 1 `boundary`)") && !summary.contains("dropped"),
         "boundary lines are facets: {summary}"
     );
     let (mesh, data) = amber_mesh::read_mesh_with_data::<2>(&vtk).unwrap();
