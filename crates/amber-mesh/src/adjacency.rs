@@ -1,31 +1,17 @@
 //! Facet adjacency: which element lies across each facet.
 
+use amber_stdx::Buckets;
+
 use crate::{Mesh, MeshError};
 
 /// The elements around each vertex, in element order (compressed rows, built by a counting sort).
 #[derive(Clone, Debug)]
-pub struct VertexElements {
-    offsets: Vec<u32>,
-    elements: Vec<u32>,
-}
+pub struct VertexElements(Buckets<u32>);
 
 impl VertexElements {
     /// The table of `cells` (`nodes_per_element` vertex indices each, all below `num_vertices`).
     pub fn new(num_vertices: usize, cells: &[u32], nodes_per_element: usize) -> Self {
-        let mut offsets = vec![0u32; num_vertices + 1];
-        for &v in cells {
-            offsets[v as usize + 1] += 1;
-        }
-        for v in 0..num_vertices {
-            offsets[v + 1] += offsets[v];
-        }
-        let mut fill = offsets.clone();
-        let mut elements = vec![0u32; cells.len()];
-        for (k, &v) in cells.iter().enumerate() {
-            elements[fill[v as usize] as usize] = (k / nodes_per_element) as u32;
-            fill[v as usize] += 1;
-        }
-        Self { offsets, elements }
+        Self(Buckets::new(num_vertices, cells.len(), |k| cells[k], |k| (k / nodes_per_element) as u32))
     }
 
     /// The table of a mesh's elements.
@@ -35,7 +21,7 @@ impl VertexElements {
 
     /// The elements containing `vertex`, ascending.
     pub fn around(&self, vertex: usize) -> &[u32] {
-        &self.elements[self.offsets[vertex] as usize..self.offsets[vertex + 1] as usize]
+        self.0.bucket(vertex)
     }
 }
 
@@ -70,29 +56,16 @@ impl FacetAdjacency {
             let odd = sort_parity(&mut key[..D]);
             (key, odd, slot as u32)
         };
-        let slots = mesh.cells().len();
-        let mut start = vec![0u32; mesh.num_vertices() + 1];
         // A facet's smallest vertex, its key's first, needs no sort.
         let smallest = |slot: usize| {
             let cell = mesh.element(slot / n);
             outward_facets::<D>()[slot % n].iter().map(|&j| cell[j]).min().unwrap_or(0)
         };
-        for slot in 0..slots {
-            start[smallest(slot) as usize + 1] += 1;
-        }
+        let mut buckets = Buckets::new(mesh.num_vertices(), mesh.cells().len(), smallest, key_of);
         for v in 0..mesh.num_vertices() {
-            start[v + 1] += start[v];
+            buckets.bucket_mut(v).sort_unstable();
         }
-        let mut fill = start.clone();
-        let mut facets = vec![([0u32; 3], false, 0u32); slots];
-        for slot in 0..slots {
-            let facet = key_of(slot);
-            facets[fill[facet.0[0] as usize] as usize] = facet;
-            fill[facet.0[0] as usize] += 1;
-        }
-        for v in 0..mesh.num_vertices() {
-            facets[start[v] as usize..start[v + 1] as usize].sort_unstable();
-        }
+        let facets = buckets.items;
         let mut neighbours = vec![Self::BOUNDARY; facets.len()];
         let mut i = 0;
         while i < facets.len() {

@@ -10,6 +10,7 @@
 //! sit at edge midpoints and are numbered after the old ones in lexicographic edge order.
 
 use amber_mesh::{Mesh2, MeshError, signed_volume};
+use amber_stdx::Buckets;
 
 /// Why a refinement or smoothing step failed.
 #[derive(Debug, thiserror::Error)]
@@ -191,29 +192,14 @@ impl EdgeTable {
     fn new(t: &[[u32; 3]], num_vertices: usize) -> Result<Self, RgbError> {
         const LOCAL: [(usize, usize); 3] = [(0, 1), (1, 2), (0, 2)];
         let key = |tri: &[u32; 3], (i, j): (usize, usize)| (tri[i].min(tri[j]), tri[i].max(tri[j]));
-        let mut offsets = vec![0u32; num_vertices + 1];
-        for tri in t {
-            for local in LOCAL {
-                offsets[key(tri, local).0 as usize + 1] += 1;
-            }
-        }
-        for v in 0..num_vertices {
-            offsets[v + 1] += offsets[v];
-        }
-        let mut fill = offsets.clone();
-        let mut bucket = vec![(0u32, 0u32); 3 * t.len()];
-        for (e, tri) in t.iter().enumerate() {
-            for (slot, local) in LOCAL.into_iter().enumerate() {
-                let (a, b) = key(tri, local);
-                bucket[fill[a as usize] as usize] = (b, (3 * e + slot) as u32);
-                fill[a as usize] += 1;
-            }
-        }
+        let slot_key = |slot: usize| key(&t[slot / 3], LOCAL[slot % 3]);
+        let mut buckets =
+            Buckets::new(num_vertices, 3 * t.len(), |slot| slot_key(slot).0, |slot| (slot_key(slot).1, slot as u32));
         let mut vertices = Vec::with_capacity(3 * t.len() / 2 + 1);
         let mut t2e = vec![[0u32; 3]; t.len()];
         let mut e2t: Vec<[u32; 2]> = Vec::with_capacity(3 * t.len() / 2 + 1);
         for a in 0..num_vertices {
-            let slots = &mut bucket[offsets[a] as usize..offsets[a + 1] as usize];
+            let slots = buckets.bucket_mut(a);
             slots.sort_unstable();
             for group in slots.chunk_by(|x, y| x.0 == y.0) {
                 if group.len() > 2 {

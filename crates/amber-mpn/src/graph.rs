@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use amber_graph::GraphBatch;
+use amber_stdx::{Buckets, offsets_of};
 use candle_core::{DType, Device, Tensor};
 use rand::Rng;
 
@@ -52,19 +53,8 @@ impl Topology {
 
     /// Builds the source-sorted index (a stable counting sort) of an already valid edge list.
     fn from_sorted(num_nodes: usize, src: Vec<u32>, dst: Vec<u32>, dst_offsets: Vec<u32>) -> Self {
-        let mut src_offsets = vec![0u32; num_nodes + 1];
-        for &s in &src {
-            src_offsets[s as usize + 1] += 1;
-        }
-        for v in 0..num_nodes {
-            src_offsets[v + 1] += src_offsets[v];
-        }
-        let mut next = src_offsets.clone();
-        let mut by_src = vec![0u32; src.len()];
-        for (k, &s) in src.iter().enumerate() {
-            by_src[next[s as usize] as usize] = k as u32;
-            next[s as usize] += 1;
-        }
+        let Buckets { offsets: src_offsets, items: by_src } =
+            Buckets::new(num_nodes, src.len(), |k| src[k], |k| k as u32);
         Self { num_nodes, src, dst, dst_offsets, by_src, src_offsets }
     }
 
@@ -98,13 +88,7 @@ impl Topology {
         let kept: Vec<u32> = (0..self.num_edges() as u32).filter(|_| rng.random::<f64>() >= p).collect();
         let src = kept.iter().map(|&k| self.src[k as usize]).collect();
         let dst: Vec<u32> = kept.iter().map(|&k| self.dst[k as usize]).collect();
-        let mut dst_offsets = vec![0u32; self.num_nodes + 1];
-        for &d in &dst {
-            dst_offsets[d as usize + 1] += 1;
-        }
-        for v in 0..self.num_nodes {
-            dst_offsets[v + 1] += dst_offsets[v];
-        }
+        let dst_offsets = offsets_of(self.num_nodes, dst.iter().copied());
         (Self::from_sorted(self.num_nodes, src, dst, dst_offsets), kept)
     }
 }

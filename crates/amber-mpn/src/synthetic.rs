@@ -25,13 +25,7 @@ pub fn random_graph(
         }
     }
     pairs.sort_unstable_by_key(|&(s, d)| (d, s));
-    let mut dst_offsets = vec![0u32; num_nodes + 1];
-    for &(_, d) in &pairs {
-        dst_offsets[d as usize + 1] += 1;
-    }
-    for v in 0..num_nodes {
-        dst_offsets[v + 1] += dst_offsets[v];
-    }
+    let dst_offsets = amber_stdx::offsets_of(num_nodes, pairs.iter().map(|&(_, d)| d));
     let num_edges = pairs.len();
     // Four regions of consecutive nodes (one per node in a graph of fewer).
     let regions = num_nodes.min(4);
