@@ -1,8 +1,10 @@
 //! Abaqus input (`.inp`): `*NODE` and `*ELEMENT, TYPE=...` blocks (data lines continue while
-//! they end with a comma; keywords are case-insensitive; `**` starts a comment; every other
-//! keyword's data is skipped). Element types are classified by their family prefix and node
-//! count (`C3D4` tetrahedron, `CPS3`/`CPE3`/`S3`/... triangle, `C3D10` and `CPS6`/... read by their
-//! corners, ...).
+//! they end with a comma; keywords are case-insensitive; `**` starts a comment), and the named
+//! groups of facets: element-side `*SURFACE`s (`element or element set, S<k>`) and the `ELSET=` of
+//! facet elements (`S3` skins); `*ELSET` blocks (listed or `GENERATE`d) are read for the
+//! surfaces that name them, and every other keyword's data is skipped. Element types are
+//! classified by their family prefix and node count (`C3D4` tetrahedron, `CPS3`/`CPE3`/`S3`/...
+//! triangle, `C3D10` and `CPS6`/... read by their corners, ...).
 //! The writer writes `*NODE` and one `*ELEMENT` block, `C3D4` or `CPS3` (second order: `C3D10`,
 //! `CPS6`, their edge nodes at the edges' midpoints), in ELSET `domain`, and
 //! the boundary as one `*NSET` (for boundary conditions) and one element-side `*SURFACE` (for
@@ -67,15 +69,56 @@ fn element_kind(ty: &str) -> Option<Kind> {
 /// What the data lines under the current keyword are.
 enum Block {
     Nodes,
-    Elements(Kind),
+    /// Elements of a kind, in the element set of a tag (0: none).
+    Elements(Kind, i32),
+    /// Members of an element set: element numbers or earlier sets, or `first, last, step` with
+    /// `GENERATE`.
+    ElementSet {
+        name: String,
+        generate: bool,
+    },
+    /// Element sides (`element or set, S<k>`) of a surface's tag.
+    Surface(i32),
     Skipped,
+}
+
+/// The value of `key=` among a keyword line's parameters, unquoted.
+fn parameter<'a>(parts: &[&'a str], key: &str) -> Option<&'a str> {
+    parts
+        .iter()
+        .filter_map(|p| p.split_once('='))
+        .find(|(k, _)| k.trim().eq_ignore_ascii_case(key))
+        .map(|(_, v)| v.trim().trim_matches('"'))
+}
+
+/// Tags for the names of element sets and surfaces (Abaqus names ignore case), 1-based in order
+/// of appearance.
+#[derive(Default)]
+struct Names {
+    tags: HashMap<String, i32>,
+    names: Vec<String>,
+}
+
+impl Names {
+    fn tag(&mut self, name: &str) -> i32 {
+        let next = self.names.len() as i32 + 1;
+        *self.tags.entry(name.to_ascii_uppercase()).or_insert_with(|| {
+            self.names.push(name.to_owned());
+            next
+        })
+    }
 }
 
 pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut lines = Lines::new(path, bytes);
     let mut raw = RawMesh::default();
     let mut node_index: HashMap<u64, u32> = HashMap::new();
-    let mut elements: Vec<(Kind, Vec<u64>, usize)> = Vec::new();
+    // (kind, element number and node numbers, line, tag).
+    let mut elements: Vec<(Kind, Vec<u64>, usize, i32)> = Vec::new();
+    let mut names = Names::default();
+    let mut sets: HashMap<String, Vec<u64>> = HashMap::new();
+    // (element number, side 1-based, tag, line).
+    let mut sides: Vec<(u64, usize, i32, usize)> = Vec::new();
     let mut block = Block::Skipped;
     let mut pending: Option<(Vec<u64>, usize)> = None;
     while let Some(line) = lines.next()? {
@@ -84,26 +127,31 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
             continue;
         }
         if let Some(keyword) = line.strip_prefix('*') {
-            let mut parts = keyword.split(',').map(str::trim);
-            let name = parts.next().unwrap_or("").to_ascii_uppercase();
-            block = match name.as_str() {
+            let parts: Vec<&str> = keyword.split(',').map(str::trim).collect();
+            let flag = |flag: &str| parts.iter().any(|p| p.eq_ignore_ascii_case(flag));
+            block = match parts[0].to_ascii_uppercase().as_str() {
                 "NODE" => Block::Nodes,
                 "ELEMENT" => {
-                    let ty = parts
-                        .filter_map(|p| p.split_once('='))
-                        .find(|(k, _)| k.trim().eq_ignore_ascii_case("TYPE"))
-                        .map(|(_, v)| v.trim())
-                        .ok_or_else(|| lines.error("*ELEMENT without TYPE="))?;
-                    Block::Elements(
-                        element_kind(ty).ok_or_else(|| lines.error(format!("element type {ty} is unknown")))?,
-                    )
+                    let ty = parameter(&parts, "TYPE").ok_or_else(|| lines.error("*ELEMENT without TYPE="))?;
+                    let kind = element_kind(ty).ok_or_else(|| lines.error(format!("element type {ty} is unknown")))?;
+                    Block::Elements(kind, parameter(&parts, "ELSET").map_or(0, |set| names.tag(set)))
                 }
+                "ELSET" => match parameter(&parts, "ELSET") {
+                    Some(name) => Block::ElementSet { name: name.to_ascii_uppercase(), generate: flag("GENERATE") },
+                    None => return Err(lines.error("*ELSET without ELSET=")),
+                },
+                "SURFACE" => match (parameter(&parts, "NAME"), parameter(&parts, "TYPE")) {
+                    (Some(name), None) => Block::Surface(names.tag(name)),
+                    (Some(name), Some(ty)) if ty.eq_ignore_ascii_case("ELEMENT") => Block::Surface(names.tag(name)),
+                    (None, _) => return Err(lines.error("*SURFACE without NAME=")),
+                    _ => Block::Skipped,
+                },
                 _ => Block::Skipped,
             };
             continue;
         }
         let words: Vec<&str> = line.split(',').map(str::trim).filter(|w| !w.is_empty()).collect();
-        match block {
+        match &block {
             Block::Nodes => {
                 let id: u64 = lines.parse(words.first().copied(), "node id")?;
                 let mut p = [0.0; 3];
@@ -117,7 +165,7 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                 }
                 raw.points.push(p);
             }
-            Block::Elements(kind) => {
+            &Block::Elements(kind, tag) => {
                 let (mut ids, line_no) = pending.take().unwrap_or((Vec::new(), lines.line));
                 for word in &words {
                     ids.push(lines.parse(Some(word), "node id")?);
@@ -125,23 +173,92 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                 if line.ends_with(',') {
                     pending = Some((ids, line_no));
                 } else {
-                    elements.push((kind, ids, line_no));
+                    elements.push((kind, ids, line_no, tag));
+                }
+            }
+            Block::ElementSet { name, generate: true } => {
+                let [first, last, step] =
+                    [0, 1, 2].map(|k| lines.parse::<u64>(words.get(k).copied(), "element number"));
+                let (first, last, step) = (first?, last?, if words.len() > 2 { step? } else { 1 });
+                if step == 0 || last < first || (last - first) / step >= bytes.len() as u64 {
+                    return Err(lines.error(format!("bad GENERATE range {first}, {last}, {step}")));
+                }
+                sets.entry(name.clone()).or_default().extend((first..=last).step_by(step as usize));
+            }
+            Block::ElementSet { name, generate: false } => {
+                let mut members = Vec::new();
+                for word in &words {
+                    match word.parse::<u64>() {
+                        Ok(id) => members.push(id),
+                        Err(_) => members.extend(set_members(&sets, word).map_err(|e| lines.error(e))?),
+                    }
+                }
+                sets.entry(name.clone()).or_default().extend(members);
+            }
+            &Block::Surface(tag) => {
+                let side = words.get(1).and_then(|w| w.strip_prefix(['S', 's'])).map(str::parse::<usize>);
+                let side = match side {
+                    Some(Ok(side @ 1..=4)) => side,
+                    // SPOS/SNEG: a side of a shell, whose own elements are the facets.
+                    None if words.len() == 2 => continue,
+                    _ => return Err(lines.error(format!("expected `element or set, S<1-4>`, found `{line}`"))),
+                };
+                match words[0].parse::<u64>() {
+                    Ok(id) => sides.push((id, side, tag, lines.line)),
+                    Err(_) => {
+                        let members = set_members(&sets, words[0]).map_err(|e| lines.error(e))?;
+                        sides.extend(members.iter().map(|&id| (id, side, tag, lines.line)));
+                    }
                 }
             }
             Block::Skipped => {}
         }
     }
-    for (kind, ids, line) in elements {
-        let nodes = ids.iter().skip(1).map(|id| {
-            node_index.get(id).copied().ok_or_else(|| MeshError::Parse {
-                path: path.to_owned(),
-                line,
-                message: format!("element {} references node {id}, which *NODE does not define", ids[0]),
-            })
-        });
-        raw.push_cell(kind, nodes.collect::<Result<Vec<u32>, _>>()?);
+    let resolve = |id: &u64, element: u64, line: usize| {
+        node_index.get(id).copied().ok_or_else(|| MeshError::Parse {
+            path: path.to_owned(),
+            line,
+            message: format!("element {element} references node {id}, which *NODE does not define"),
+        })
+    };
+    let mut element_index: HashMap<u64, usize> = HashMap::new();
+    for (k, (kind, ids, line, tag)) in elements.iter().enumerate() {
+        let nodes = ids.iter().skip(1).map(|id| resolve(id, ids[0], *line));
+        raw.push_cell(*kind, nodes.collect::<Result<Vec<u32>, _>>()?);
+        raw.tags.push(*tag);
+        element_index.insert(ids[0], k);
     }
+    for (element, side, tag, line) in sides {
+        let error = |message: String| MeshError::Parse { path: path.to_owned(), line, message };
+        let &k = element_index
+            .get(&element)
+            .ok_or_else(|| error(format!("surface side of element {element}, which *ELEMENT does not define")))?;
+        let (kind, ids, _, _) = &elements[k];
+        // Sides of other elements are dropped with them; one with too few nodes fails in `finish`.
+        let simplex = matches!(*kind, Kind::TETRA | Kind::TETRA10 | Kind::TRIANGLE | Kind::TRIANGLE6);
+        if !simplex || ids.len() < kind.dim + 2 {
+            continue;
+        }
+        let local: &[usize] = match (kind.dim, side) {
+            (3, 1..=4) => &[[0, 1, 2], [0, 3, 1], [1, 3, 2], [2, 3, 0]][side - 1],
+            (2, 1..=3) => &[[0, 1], [1, 2], [2, 0]][side - 1],
+            _ => return Err(error(format!("element {element} ({}) has no side S{side}", kind.name))),
+        };
+        let nodes = local.iter().map(|&j| resolve(&ids[1 + j], element, line));
+        raw.push_cell(Kind::simplex(kind.dim - 1), nodes.collect::<Result<Vec<u32>, _>>()?);
+        raw.tags.push(tag);
+    }
+    let tagged: std::collections::BTreeSet<(usize, i32)> =
+        raw.kinds.iter().zip(&raw.tags).filter(|(_, t)| **t != 0).map(|(kind, &t)| (kind.dim, t)).collect();
+    raw.tag_names = tagged.into_iter().map(|(dim, t)| (dim, t, names.names[t as usize - 1].clone())).collect();
     Ok(raw)
+}
+
+/// The members of the element set `name`, defined earlier in the file.
+fn set_members<'a>(sets: &'a HashMap<String, Vec<u64>>, name: &str) -> Result<&'a [u64], String> {
+    sets.get(&name.trim_matches('"').to_ascii_uppercase())
+        .map(Vec::as_slice)
+        .ok_or_else(|| format!("`{name}` is neither an element number nor an element set defined before"))
 }
 
 /// Abaqus's number of the side of a `C3D4` or `CPS3` opposite each local node: `C3D4` faces are
@@ -325,5 +442,58 @@ mod tests {
         quoted.facet_names.insert(8, "n".repeat(81));
         let err = write(&tet, &quoted, &mut bytes, Path::new("x.inp"));
         assert!(err.unwrap_err().to_string().contains("at most 80 characters"));
+    }
+
+    /// The named surfaces amber writes come back as named facet groups.
+    #[test]
+    fn reads_its_surfaces_back_as_named_facet_groups() {
+        let tet =
+            crate::Mesh3::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], vec![0, 1, 2, 3]);
+        let tet = tet.unwrap();
+        let data = MeshData::new()
+            .with_facet_tag([0, 1, 2], 5)
+            .with_facet_tag([0, 3, 1], 7)
+            .with_facet_tag([1, 3, 2], 7)
+            .with_facet_name(7, "inlet wall");
+        let mut bytes = Vec::new();
+        write(&Nodes::new(&tet, ElementOrder::Linear), &data, &mut bytes, Path::new("x.inp")).unwrap();
+        let (back, back_data) = parse::<3>(std::str::from_utf8(&bytes).unwrap()).unwrap();
+        assert_eq!(back, tet);
+        let name_of = |facet: &[u32]| back_data.facet_names[&back_data.facet_tags[facet]].as_str();
+        assert_eq!(name_of(&[0, 1, 2]), "boundary_5");
+        assert_eq!((name_of(&[0, 1, 3]), name_of(&[1, 2, 3])), ("inlet wall", "inlet wall"));
+        assert_eq!(name_of(&[0, 2, 3]), "boundary_8");
+    }
+
+    /// Element sets (listed, generated, or of `*ELEMENT, ELSET=`) and surfaces over them.
+    #[test]
+    fn element_sets_and_surfaces_tag_facets() {
+        let nodes = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n5, 1, 1, 1\n";
+        let text = format!(
+            "{nodes}*ELEMENT, TYPE=C3D4, ELSET=solid\n1, 1, 2, 3, 4\n2, 2, 3, 4, 5\n\
+             *ELSET, ELSET=_first, GENERATE\n1, 1, 1\n*ELSET, ELSET=both\n_first, 2\n\
+             *SURFACE, TYPE=ELEMENT, NAME=Bottom\n_FIRST, S1\n*SURFACE, NAME=tops\nboth, S3\n\
+             *SURFACE, TYPE=NODE, NAME=ignored\n1, 1.0\n*ELEMENT, TYPE=S3, ELSET=skin\n9, 1, 2, 4\n"
+        );
+        let (mesh, data) = parse::<3>(&text).unwrap();
+        assert_eq!(mesh.num_elements(), 2);
+        let names: Vec<&str> = data.facet_names.values().map(String::as_str).collect();
+        assert_eq!(names, ["Bottom", "tops", "skin"]);
+        let tag = |name: &str| *data.facet_names.iter().find(|(_, n)| *n == name).unwrap().0;
+        assert_eq!(data.facet_tags[&vec![0, 1, 2]], tag("Bottom"));
+        // S3 of element 1 is nodes 2-4-3, of element 2 nodes 3-5-4 (0-based 1-3-2 and 2-4-3).
+        assert_eq!(data.facet_tags[&vec![1, 2, 3]], tag("tops"));
+        assert_eq!(data.facet_tags[&vec![2, 3, 4]], tag("tops"));
+        assert_eq!(data.facet_tags[&vec![0, 1, 3]], tag("skin"));
+        for (bad, expected) in [
+            ("*SURFACE, NAME=s\nnowhere, S1\n", "neither an element number nor an element set"),
+            ("*SURFACE, NAME=s\n1, S9\n", "S<1-4>"),
+            ("*SURFACE, NAME=s\n3, S1\n", "element 3, which *ELEMENT does not define"),
+            ("*ELSET, ELSET=g, GENERATE\n5, 1, 1\n", "bad GENERATE range"),
+        ] {
+            let text = format!("{nodes}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n{bad}");
+            let err = parse::<3>(&text).unwrap_err().to_string();
+            assert!(err.contains("inline.inp:") && err.contains(expected), "{bad}: {err}");
+        }
     }
 }

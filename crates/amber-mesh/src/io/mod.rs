@@ -37,7 +37,8 @@ use crate::{Mesh, Mesh2, Mesh3, MeshError};
 ///
 /// `.vtu`, `.vtk`, `.msh` and `.json` store the fields; `.nas`, `.inp` and `.mesh` none. `.msh`
 /// and `.mesh` store the facet tags (`.msh` with their names); `.inp` writes them as named node
-/// sets and element-side surfaces, and `.nas` (3D) as skin triangles under one property per tag.
+/// sets and element-side surfaces (and reads the surfaces, and element sets of facet elements,
+/// as named groups), and `.nas` (3D) as skin triangles under one property per tag.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {
     /// Per-element fields, by name.
@@ -612,7 +613,7 @@ mod tests {
                     (data.cell, data.point),
                     if has_fields { (d2.cell.clone(), d2.point.clone()) } else { Default::default() }
                 );
-                let boundary_edges = if matches!(ext, "msh" | "mesh") { 4 } else { 0 };
+                let boundary_edges = if matches!(ext, "msh" | "mesh" | "inp") { 4 } else { 0 };
                 assert_eq!(data.facet_tags.len(), boundary_edges, "{ext}");
                 let p3 = dir.join(format!("m3.{ext}"));
                 write_mesh_as(&m3, &p3, &d3, WriteOptions { encoding, ..Default::default() }).unwrap();
