@@ -119,6 +119,16 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut sets: HashMap<String, Vec<u64>> = HashMap::new();
     // (element number, side 1-based, tag, line).
     let mut sides: Vec<(u64, usize, i32, usize)> = Vec::new();
+    // Sets and surfaces name sets again and again; expanded, they never need more entries than
+    // four per byte of the file (an element takes more than a byte, and has at most four sides).
+    let mut expanded = 0usize;
+    let mut expand = |n: usize, lines: &Lines| -> Result<(), MeshError> {
+        expanded += n;
+        if expanded > 4 * bytes.len() {
+            return Err(lines.error("element sets and surfaces list more entries than the file could have elements"));
+        }
+        Ok(())
+    };
     let mut block = Block::Skipped;
     let mut pending: Option<(Vec<u64>, usize)> = None;
     while let Some(line) = lines.next()? {
@@ -183,6 +193,7 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                 if step == 0 || last < first || (last - first) / step >= bytes.len() as u64 {
                     return Err(lines.error(format!("bad GENERATE range {first}, {last}, {step}")));
                 }
+                expand(((last - first) / step + 1) as usize, &lines)?;
                 sets.entry(name.clone()).or_default().extend((first..=last).step_by(step as usize));
             }
             Block::ElementSet { name, generate: false } => {
@@ -193,6 +204,7 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                         Err(_) => members.extend(set_members(&sets, word).map_err(|e| lines.error(e))?),
                     }
                 }
+                expand(members.len(), &lines)?;
                 sets.entry(name.clone()).or_default().extend(members);
             }
             &Block::Surface(tag) => {
@@ -207,6 +219,7 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
                     Ok(id) => sides.push((id, side, tag, lines.line)),
                     Err(_) => {
                         let members = set_members(&sets, words[0]).map_err(|e| lines.error(e))?;
+                        expand(members.len(), &lines)?;
                         sides.extend(members.iter().map(|&id| (id, side, tag, lines.line)));
                     }
                 }
@@ -490,6 +503,7 @@ mod tests {
             ("*SURFACE, NAME=s\n1, S9\n", "S<1-4>"),
             ("*SURFACE, NAME=s\n3, S1\n", "element 3, which *ELEMENT does not define"),
             ("*ELSET, ELSET=g, GENERATE\n5, 1, 1\n", "bad GENERATE range"),
+            (&"*ELSET, ELSET=g, GENERATE\n1, 100, 1\n*ELSET, ELSET=h\ng, g, g\n".repeat(8), "more entries than"),
         ] {
             let text = format!("{nodes}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n{bad}");
             let err = parse::<3>(&text).unwrap_err().to_string();
