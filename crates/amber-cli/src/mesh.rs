@@ -81,9 +81,10 @@ pub struct MeshArgs {
     /// SIZE (a contact face, a hole's wall, a loaded edge): `FACE,SIZE`, FACE the number of a CAD
     /// face of a solid or of a side of a polygon, as in the written mesh's `boundary_<FACE>`
     /// groups, or the name the geometry gives a face (a physical group of a mesh file, a solid of
-    /// an ASCII STL, a group of an OBJ; `--list-faces` lists them). The last step's field is held at the fraction of SIZE of --refine-box on every
-    /// element of the mesh before it with a vertex on the face, a layer as deep as that mesh's
-    /// elements there; --elements counts them in. May be given more than once.
+    /// an ASCII STL, a group of an OBJ; `--list-faces` lists them). The last step's field is held
+    /// at the fraction of SIZE of --refine-box on every element of the mesh before it with a
+    /// vertex on the face, a layer as deep as that mesh's elements there; --elements counts them
+    /// in. May be given more than once.
     #[arg(long, value_parser = parse_refine_face, value_name = "FACE,SIZE")]
     refine_face: Vec<RefineFaceArg>,
     /// Inputs beyond the geometry, for models that read them: a Poisson problem JSON (its load,

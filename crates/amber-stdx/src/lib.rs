@@ -3,9 +3,10 @@
 //! temporary file beside the target, fsynced, renamed, the directory fsynced), JSON files read
 //! and written with errors that name the file ([`read_json`], [`write_json_atomic`]), the
 //! quantile and median of a sample ([`quantile`], [`median`]), and items grouped by a small
-//! integer key in linear time, the compressed rows of every adjacency table ([`Buckets`]). It depends on no crate of ours
-//! and knows nothing of meshes, sizing fields, FEM, graphs, learning or experiments; every
-//! crate may depend on it, and each maps [`FileError`] into its own error type.
+//! integer key in linear time, the compressed rows of every adjacency table ([`Buckets`]). It
+//! depends on no crate of ours and knows nothing of meshes, sizing fields, FEM, graphs, learning
+//! or experiments; every crate may depend on it, and each maps [`FileError`] into its own error
+//! type.
 
 mod buckets;
 mod fs;

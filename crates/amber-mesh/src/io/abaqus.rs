@@ -322,7 +322,8 @@ fn abaqus_label(name: &str) -> Result<String, String> {
     let label = if plain { name.to_owned() } else { format!("\"{name}\"") };
     if name.is_empty() || name.contains(['"', '\n', '\r']) || label.chars().count() > 80 {
         Err(format!(
-            "facet group name {name:?} cannot be an Abaqus set name (at most 80 characters with its quotes, no quotes or line breaks)"
+            "facet group name {name:?} cannot be an Abaqus set name (at most 80 characters with its quotes, \
+             no quotes or line breaks)"
         ))
     } else {
         Ok(label)
