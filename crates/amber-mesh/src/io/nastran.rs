@@ -7,7 +7,9 @@
 //! NASTRAN's implicit exponent (`-7.11-15` = -7.11e-15). GRID ids may have gaps.
 //!
 //! An element's property id (PID) is its tag: in a tet mesh, the CTRIA3 (CTRIA6) skin
-//! triangles become facet tags by their PID, as the physical groups of a `.msh` do.
+//! triangles become facet tags by their PID, as the physical groups of a `.msh` do, named by the
+//! comments pre-processors write for their properties (ANSA's `$ANSA_NAME_COMMENT;PID;PSHELL;NAME;`,
+//! HyperMesh's `$HMNAME PROP PID "NAME"`); NASTRAN itself has no place for a name.
 //!
 //! The writer writes free-field cards (GRID, CTETRA or CTRIA3; second order: CTETRA with its six
 //! edge grids, four of them on a `+` continuation line, or CTRIA6) with coordinates in their
@@ -15,12 +17,13 @@
 //! back bit-exactly, and else to 5e-11 relative (a coordinate's exponent of one or two digits).
 //! The model is laid out as the Console experts' ANSA files are: a tet mesh's CTETRA under one
 //! PSOLID, and its boundary as CTRIA3 (CTRIA6) skin triangles, outward, one PSHELL per facet tag
-//! (PID = tag; the untagged boundary one past the largest tag), the solid's PID one past those.
+//! (PID = tag; the untagged boundary one past the largest tag), the solid's PID one past those;
+//! a named facet group's PSHELL carries its name in both pre-processors' comments.
 //! The skin's PSHELLs name no material, so in MSC Nastran they add no stiffness: they carry the
 //! faces' groups for loads and constraints. The PSOLID (and a triangle mesh's PSHELL, thickness
 //! 1) reference material 1, which the file does not define: the user's solver deck does.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io::Write;
 use std::path::Path;
 
@@ -51,9 +54,14 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
     // Element grid ids with their PID and line, resolved once every GRID is known (cards may come
     // in any order).
     let mut elements: Vec<(Kind, Vec<u64>, i32, usize)> = Vec::new();
+    let mut names = BTreeMap::new();
     let mut complete = false;
     while let Some(line) = lines.next()? {
-        if line.starts_with('$') || line.trim().is_empty() {
+        if line.starts_with('$') {
+            names.extend(property_name(line));
+            continue;
+        }
+        if line.trim().is_empty() {
             continue;
         }
         let name = line.split(',').next().unwrap_or(line);
@@ -120,11 +128,35 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
         raw.push_cell(kind, nodes.collect::<Result<Vec<u32>, _>>()?);
         raw.tags.push(pid);
     }
+    // Properties name elements of any dimension; `finish` keeps the names of skin (facet) tags.
+    raw.tag_names = names.into_iter().map(|(pid, name)| (2, pid, name)).collect();
     if !complete {
         let message = format!("no ENDDATA after line {}: the file is truncated", lines.line);
         return Err(MeshError::Format { path: path.to_owned(), message });
     }
     Ok(raw)
+}
+
+/// A property's name from the comment a pre-processor writes beside it: ANSA's
+/// `$ANSA_NAME_COMMENT;PID;CARD;NAME;...` for a property card (`PSHELL`, `PSOLID`, ...) or
+/// HyperMesh's `$HMNAME PROP PID"NAME"`. Any other comment, or one cut short before the name
+/// ends (a wrapped line), names nothing: a comment never makes a deck unreadable.
+fn property_name(line: &str) -> Option<(i32, String)> {
+    let (pid, name) = if let Some(rest) = line.strip_prefix("$ANSA_NAME_COMMENT;") {
+        // Four pieces: the name's own `;` must be there for the name to be whole.
+        let fields: Vec<&str> = rest.splitn(4, ';').collect();
+        match fields[..] {
+            [pid, card, name, _] if card.starts_with('P') => (pid, name),
+            _ => return None,
+        }
+    } else {
+        let rest = line.strip_prefix("$HMNAME PROP")?;
+        let (pid, quoted) = rest.split_once('"')?;
+        (pid, quoted.split_once('"')?.0)
+    };
+    let pid = pid.trim().parse::<i32>().ok().filter(|&p| p > 0)?;
+    let name = name.trim();
+    (!name.is_empty()).then(|| (pid, name.to_owned()))
 }
 
 pub(super) fn write<const D: usize>(
@@ -137,12 +169,26 @@ pub(super) fn write<const D: usize>(
     let skin = if D == 3 { tagged_facets(mesh, &writer_adjacency(mesh, path)?, data, path)? } else { Vec::new() };
     require_positive_tags(&skin, path, "NASTRAN property ids")?;
     let solid = skin.iter().map(|&(_, t)| t).max().map_or(1, |t| t.saturating_add(1));
-    write_body(nodes, &skin, solid, w).map_err(write_error(path))
+    let names: BTreeMap<i32, &str> = (data.facet_names.iter())
+        // `tagged_facets` sorts the skin by tag.
+        .filter(|(tag, _)| skin.binary_search_by_key(*tag, |(_, t)| *t).is_ok())
+        .map(|(&tag, name)| {
+            if name.contains(['"', ';', '\n', '\r']) {
+                let message = format!(
+                    "facet group name {name:?} cannot be a NASTRAN property's name comment (no quotes, semicolons or line breaks)"
+                );
+                return Err(MeshError::Format { path: path.to_owned(), message });
+            }
+            Ok((tag, name.as_str()))
+        })
+        .collect::<Result<_, _>>()?;
+    write_body(nodes, &skin, &names, solid, w).map_err(write_error(path))
 }
 
 fn write_body<const D: usize>(
     nodes: &Nodes<D>,
     skin: &[(Vec<u32>, i32)],
+    names: &BTreeMap<i32, &str>,
     solid: i32,
     w: &mut impl Write,
 ) -> std::io::Result<()> {
@@ -182,8 +228,15 @@ fn write_body<const D: usize>(
     }
     let mut tags: Vec<i32> = skin.iter().map(|&(_, t)| t).collect();
     tags.dedup();
+    // Each pre-processor's own way: HyperMesh's before the card, ANSA's at the end of the model.
     for tag in tags {
+        if let Some(name) = names.get(&tag) {
+            writeln!(w, "$HMNAME PROP {tag} \"{name}\"")?;
+        }
         writeln!(w, "PSHELL,{tag}")?;
+    }
+    for (tag, name) in names {
+        writeln!(w, "$ANSA_NAME_COMMENT;{tag};PSHELL;{name};;NO;NO;NO;NO;")?;
     }
     writeln!(w, "ENDDATA")
 }
@@ -311,18 +364,22 @@ GRID          99            junk\r\n";
         assert!(data.dropped.is_empty(), "a skin triangle is a facet tag, not a dropped element: {:?}", data.dropped);
     }
 
-    #[test]
-    fn writes_the_boundary_as_outward_skin_groups_under_their_own_properties() {
-        // A cube of six tets around its diagonal; two facets of the face z = 0 tagged 4 and one
-        // of x = 1 tagged 9, the rest of the boundary untagged.
+    /// A cube of six tets around its diagonal; two facets of the face z = 0 tagged 4 and one of
+    /// x = 1 tagged 9, the rest of the boundary untagged.
+    fn tagged_cube() -> (Mesh3, MeshData) {
         let vertices: Vec<[f64; 3]> =
             (0..8).map(|k| [(k & 1) as f64, ((k >> 1) & 1) as f64, ((k >> 2) & 1) as f64]).collect();
         let cells = vec![0, 1, 3, 7, 0, 1, 5, 7, 0, 2, 3, 7, 0, 2, 6, 7, 0, 4, 5, 7, 0, 4, 6, 7];
-        let mesh = Mesh3::new_reoriented(vertices, cells).unwrap();
         let data = MeshData::new()
             .with_facet_tag(vec![0, 1, 3], 4)
             .with_facet_tag(vec![0, 2, 3], 4)
             .with_facet_tag(vec![1, 3, 7], 9);
+        (Mesh3::new_reoriented(vertices, cells).unwrap(), data)
+    }
+
+    #[test]
+    fn writes_the_boundary_as_outward_skin_groups_under_their_own_properties() {
+        let (mesh, data) = tagged_cube();
         let path = Path::new("cube.nas");
         for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
             let mut bytes = Vec::new();
@@ -364,6 +421,65 @@ GRID          99            junk\r\n";
         let message =
             write(&Nodes::new(&mesh, ElementOrder::Linear), &negative, &mut Vec::new(), path).unwrap_err().to_string();
         assert!(message.contains("cube.nas") && message.contains("positive"), "{message}");
+    }
+
+    #[test]
+    fn names_skin_properties_in_both_pre_processors_comments() {
+        let (mesh, mut data) = tagged_cube();
+        data.facet_names = BTreeMap::from([(4, "bolt seat".into()), (9, "weld-2".into()), (12, "unused".into())]);
+        let path = Path::new("cube.nas");
+        let mut bytes = Vec::new();
+        write(&Nodes::new(&mesh, ElementOrder::Linear), &data, &mut bytes, path).unwrap();
+        let text = String::from_utf8(bytes.clone()).unwrap();
+        for line in [
+            "$HMNAME PROP 4 \"bolt seat\"\nPSHELL,4\n",
+            "$HMNAME PROP 9 \"weld-2\"\nPSHELL,9\n",
+            "$ANSA_NAME_COMMENT;4;PSHELL;bolt seat;;NO;NO;NO;NO;\n",
+            "$ANSA_NAME_COMMENT;9;PSHELL;weld-2;;NO;NO;NO;NO;\nENDDATA",
+        ] {
+            assert!(text.contains(line), "{line:?} in\n{text}");
+        }
+        assert!(!text.contains("unused"), "a name without facets is not written");
+        let (_, back) = read(path, &bytes).unwrap().finish::<3>(path).unwrap();
+        assert_eq!(back.facet_names, BTreeMap::from([(4, "bolt seat".into()), (9, "weld-2".into())]));
+        // The untagged rest of the boundary (PSHELL 10) stays unnamed.
+        assert_eq!(back.facet_tags.values().filter(|&&t| t == 10).count(), 9);
+        for bad in ["a;b", "say \"hi\"", "two\nlines"] {
+            data.facet_names.insert(4, bad.into());
+            let message =
+                write(&Nodes::new(&mesh, ElementOrder::Linear), &data, &mut Vec::new(), path).unwrap_err().to_string();
+            assert!(message.contains("cube.nas") && message.contains("name comment"), "{message}");
+        }
+    }
+
+    #[test]
+    fn reads_property_names_from_ansa_and_hypermesh_comments() {
+        let named = |comments: &str| {
+            let text = TWO_TETS.replacen("BEGIN BULK", &format!("BEGIN BULK\r\n{comments}"), 1);
+            let path = Path::new("named.nas");
+            read(path, text.as_bytes()).unwrap().finish::<3>(path).unwrap().1.facet_names
+        };
+        let skin = |name: &str| BTreeMap::from([(375, name.to_owned())]);
+        assert_eq!(named("$ANSA_NAME_COMMENT;375;PSHELL;Part 1;;NO;NO;NO;NO;"), skin("Part 1"));
+        assert_eq!(named("$HMNAME PROP                 375\"clamp face\"       4"), skin("clamp face"));
+        assert_eq!(named("$HMNAME PROP 375 \"clamp face\""), skin("clamp face"));
+        // The solid's property name and a material's name no facet; the later comment wins.
+        let both = "$ANSA_NAME_COMMENT;374;PSOLID;Part 1_Volume_375;;NO;NO;NO;NO;\n\
+                    $ANSA_NAME_COMMENT;375;MAT1;steel;;NO;NO;NO;\n\
+                    $HMNAME PROP 375 \"first\"\n$ANSA_NAME_COMMENT;375;PSHELL;second;;";
+        assert_eq!(named(both), skin("second"));
+        // Comments cut short or malformed name nothing, and the deck still reads.
+        for comment in [
+            "$ANSA_NAME_COMMENT;375;PSHELL;a name wrapped at column eighty without its",
+            "$ANSA_NAME_COMMENT;x75;PSHELL;Part 1;;",
+            "$ANSA_NAME_COMMENT;-375;PSHELL;Part 1;;",
+            "$ANSA_NAME_COMMENT;375;PSHELL;  ;;",
+            "$HMNAME PROP 375 \"no closing quote",
+            "$HMNAME PROPERTIES 375\"an LS-DYNA comment\"",
+            "$HMNAME COMP 375 \"a component\"",
+        ] {
+            assert_eq!(named(comment), BTreeMap::new(), "{comment}");
+        }
     }
 
     #[test]
@@ -441,7 +557,8 @@ GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nGRID,5,,1.,1.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA
     }
 
     /// Reads every console expert mesh shipped in shared/data (19 train + 2 val): positive
-    /// volumes after reorientation, and the published range of 7,800–41,856 tetrahedra.
+    /// volumes after reorientation, the published range of 7,800–41,856 tetrahedra, and the
+    /// skin's name from ANSA's comment.
     #[test]
     fn reads_every_console_mesh() {
         let Some(root) = amber_testdata::shared("data/console") else { return };
@@ -459,8 +576,10 @@ GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nGRID,5,,1.,1.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA
                 .iter()
                 .map(|path| {
                     s.spawn(move || {
-                        let mesh: Mesh3 = crate::read_mesh(path).unwrap_or_else(|e| panic!("{e}"));
+                        let (mesh, data) = crate::read_mesh_with_data::<3>(path).unwrap_or_else(|e| panic!("{e}"));
                         assert!(mesh.volumes().iter().all(|&v| v > 0.0), "{}", path.display());
+                        // ANSA names each part's one skin property.
+                        assert_eq!(data.facet_names.values().collect::<Vec<_>>(), ["Part 1"], "{}", path.display());
                         mesh.num_elements()
                     })
                 })
