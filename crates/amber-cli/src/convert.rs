@@ -61,12 +61,13 @@ fn write<const D: usize>(
     let options = WriteOptions { encoding, order: args.order };
     write_mesh_as(mesh, &args.output, data, options).context("cannot write the output mesh")?;
     let mut summary = format!(
-        "{} -> {}: {} vertices, {} {}D elements{}, {} cell and {} point fields, {} tagged facets",
+        "{} -> {}: {} vertices, {} {}D elements{}{}, {} cell and {} point fields, {} tagged facets",
         args.input.display(),
         args.output.display(),
         mesh.num_vertices(),
         mesh.num_elements(),
         D,
+        data.domain_name.as_ref().map_or(String::new(), |name| format!(" in `{name}`")),
         if args.order == ElementOrder::Quadratic { " written as second order" } else { "" },
         data.cell.len(),
         data.point.len(),

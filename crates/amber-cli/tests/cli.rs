@@ -181,7 +181,9 @@ fn converts_between_formats_in_the_dimension_of_the_file() {
     assert!(output.status.success());
     let summary = String::from_utf8_lossy(&output.stderr);
     assert!(
-        summary.contains("4 tagged facets (named: 1 `boundary`)") && !summary.contains("dropped"),
+        summary.contains("2 2D elements in `domain`")
+            && summary.contains("4 tagged facets (named: 1 `boundary`)")
+            && !summary.contains("dropped"),
         "boundary lines are facets: {summary}"
     );
     let (mesh, data) = amber_mesh::read_mesh_with_data::<2>(&vtk).unwrap();

@@ -310,7 +310,9 @@ pub(super) fn write<const D: usize>(
         .map(|&tag| abaqus_label(&data.group_name(tag, groups.len())).map(|label| (tag, label)))
         .collect::<Result<BTreeMap<i32, String>, String>>()
         .map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
-    write_body(nodes, &groups, &names, w).map_err(write_error(path))
+    let domain = abaqus_label(data.domain_group_name())
+        .map_err(|message| MeshError::Format { path: path.to_owned(), message })?;
+    write_body(nodes, &groups, &names, &domain, w).map_err(write_error(path))
 }
 
 /// `name` as an Abaqus set or surface name: as it is when it is a plain label (a letter, then
@@ -322,7 +324,7 @@ fn abaqus_label(name: &str) -> Result<String, String> {
     let label = if plain { name.to_owned() } else { format!("\"{name}\"") };
     if name.is_empty() || name.contains(['"', '\n', '\r']) || label.chars().count() > 80 {
         Err(format!(
-            "facet group name {name:?} cannot be an Abaqus set name (at most 80 characters with its quotes, \
+            "group name {name:?} cannot be an Abaqus set name (at most 80 characters with its quotes, \
              no quotes or line breaks)"
         ))
     } else {
@@ -334,6 +336,7 @@ fn write_body<const D: usize>(
     nodes: &Nodes<D>,
     groups: &BTreeMap<i32, Vec<(usize, usize)>>,
     names: &BTreeMap<i32, String>,
+    domain: &str,
     w: &mut impl Write,
 ) -> std::io::Result<()> {
     let mesh = nodes.mesh();
@@ -351,7 +354,7 @@ fn write_body<const D: usize>(
         (_, false) => "C3D4",
         (_, true) => "C3D10",
     };
-    writeln!(w, "*ELEMENT, TYPE={kind}, ELSET=domain")?;
+    writeln!(w, "*ELEMENT, TYPE={kind}, ELSET={domain}")?;
     for (e, cell) in nodes.elements().enumerate() {
         write!(w, "{}", e + 1)?;
         for v in cell {
@@ -469,10 +472,14 @@ mod tests {
             .with_facet_tag([0, 3, 1], 7)
             .with_facet_tag([1, 3, 2], 7)
             .with_facet_name(7, "inlet wall");
+        let data = MeshData { domain_name: Some("BRACKET-1".into()), ..data };
         let mut bytes = Vec::new();
         write(&Nodes::new(&tet, ElementOrder::Linear), &data, &mut bytes, Path::new("x.inp")).unwrap();
-        let (back, back_data) = parse::<3>(std::str::from_utf8(&bytes).unwrap()).unwrap();
+        let text = std::str::from_utf8(&bytes).unwrap();
+        assert!(text.contains("*ELEMENT, TYPE=C3D4, ELSET=\"BRACKET-1\"\n"), "{text}");
+        let (back, back_data) = parse::<3>(text).unwrap();
         assert_eq!(back, tet);
+        assert_eq!(back_data.domain_name.as_deref(), Some("BRACKET-1"));
         let name_of = |facet: &[u32]| back_data.facet_names[&back_data.facet_tags[facet]].as_str();
         assert_eq!(name_of(&[0, 1, 2]), "boundary_5");
         assert_eq!((name_of(&[0, 1, 3]), name_of(&[1, 2, 3])), ("inlet wall", "inlet wall"));
@@ -499,6 +506,12 @@ mod tests {
         assert_eq!(data.facet_tags[&vec![1, 2, 3]], tag("tops"));
         assert_eq!(data.facet_tags[&vec![2, 3, 4]], tag("tops"));
         assert_eq!(data.facet_tags[&vec![0, 1, 3]], tag("skin"));
+        assert_eq!(data.domain_name.as_deref(), Some("solid"));
+        // Elements in two sets: the domain has no one name.
+        let two = format!(
+            "{nodes}*ELEMENT, TYPE=C3D4, ELSET=a\n1, 1, 2, 3, 4\n*ELEMENT, TYPE=C3D4, ELSET=b\n2, 2, 3, 4, 5\n"
+        );
+        assert_eq!(parse::<3>(&two).unwrap().1.domain_name, None);
         for (bad, expected) in [
             ("*SURFACE, NAME=s\nnowhere, S1\n", "neither an element number nor an element set"),
             ("*SURFACE, NAME=s\n1, S9\n", "S<1-4>"),

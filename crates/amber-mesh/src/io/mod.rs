@@ -55,6 +55,10 @@ pub struct MeshData {
     /// their boundary groups: a solver setup refers to `inlet`, not to tag 7. A tag without a
     /// name is written as `boundary_<tag>` (`boundary` when it is the only group).
     pub facet_names: BTreeMap<i32, String>,
+    /// The name of the domain's element group when every element carries the same named one (a
+    /// `.msh` physical group's, an Abaqus element set's, which its section assignment refers to,
+    /// a NASTRAN solid property's comment); writers call the domain so, else `domain`.
+    pub domain_name: Option<String>,
     /// Elements a reader dropped because they are neither simplices of the mesh dimension nor
     /// tagged facets (those are in `facet_tags`), counted by kind (`line`, `quad`, `hexahedron`,
     /// ...). Writers ignore it.
@@ -105,6 +109,11 @@ impl MeshData {
             None if groups == 1 => "boundary".to_owned(),
             None => format!("boundary_{tag}"),
         }
+    }
+
+    /// The name the writers give the domain's element group.
+    fn domain_group_name(&self) -> &str {
+        self.domain_name.as_deref().unwrap_or("domain")
     }
 
     /// Whether there are no fields and no facet tags.

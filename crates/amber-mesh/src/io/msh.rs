@@ -497,7 +497,9 @@ pub(super) fn write<const D: usize>(
     path: &Path,
 ) -> Result<(), MeshError> {
     let names = data.cell.keys().chain(data.point.keys()).map(|n| ("field", n));
-    for (what, name) in names.chain(data.facet_names.values().map(|n| ("facet group name", n))) {
+    let groups = data.facet_names.values().map(|n| ("facet group name", n));
+    let domain = data.domain_name.iter().map(|n| ("domain name", n));
+    for (what, name) in names.chain(groups).chain(domain) {
         if name.contains(['"', '\n', '\r']) {
             return Err(MeshError::Format {
                 path: path.to_owned(),
@@ -533,7 +535,7 @@ fn write_body<const D: usize, W: Write>(
     out.line("$EndMeshFormat")?;
 
     out.line("$PhysicalNames")?;
-    out.line(&format!("{}\n{D} 1 \"domain\"", groups.len() + 1))?;
+    out.line(&format!("{}\n{D} 1 \"{}\"", groups.len() + 1, data.domain_group_name()))?;
     for &tag in groups.keys() {
         out.line(&format!("{} {tag} \"{}\"", D - 1, data.group_name(tag, groups.len())))?;
     }
@@ -740,6 +742,7 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
             .with_point("u", vec![5e-324, 1e300, -2.5, -0.0])
             .with_facet_tag([0, 1, 2], 3)
             .with_facet_name(3, "inlet wall");
+        let data = MeshData { domain_name: Some("steel bracket".into()), ..data };
         for binary in [false, true] {
             let bytes = written(&mesh, &data, binary);
             let path = Path::new("x.msh");
@@ -752,11 +755,15 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
             assert_eq!(back_data.facet_tags[&vec![0, 1, 2]], 3);
             assert_eq!(back_data.facet_tags.values().filter(|&&t| t == 4).count(), 3);
             assert_eq!(back_data.facet_names, BTreeMap::from([(3, "inlet wall".into()), (4, "boundary_4".into())]));
+            assert_eq!(back_data.domain_name.as_deref(), Some("steel bracket"));
         }
         let linear = Nodes::new(&mesh, ElementOrder::Linear);
         let quoted = data.with_facet_name(3, "say \"hi\"");
         let err = write(&linear, &quoted, false, &mut Vec::new(), Path::new("x.msh")).unwrap_err().to_string();
         assert!(err.contains("facet group name") && err.contains("x.msh"), "{err}");
+        let quoted = MeshData { domain_name: Some("a \"b\"".into()), ..MeshData::new() };
+        let err = write(&linear, &quoted, false, &mut Vec::new(), Path::new("x.msh")).unwrap_err().to_string();
+        assert!(err.contains("domain name") && err.contains("x.msh"), "{err}");
     }
 
     #[test]
@@ -775,6 +782,7 @@ $NodeData\n1\n\"vec\"\n1\n0.0\n3\n0\n3\n1\n1 1 2 3\n$EndNodeData\n";
         let (back, data) = parse::<2>(&text).unwrap();
         assert_eq!(back, mesh);
         assert_eq!(data.facet_tags.len(), 3);
+        assert_eq!(data.domain_name.as_deref(), Some("domain"));
         let linear = Nodes::new(&mesh, ElementOrder::Linear);
         let err =
             write(&linear, &MeshData::new().with_facet_tag([0, 1], 0), false, &mut Vec::new(), Path::new("x.msh"));

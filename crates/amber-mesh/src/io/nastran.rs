@@ -128,8 +128,8 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<RawMesh, MeshError> {
         raw.push_cell(kind, nodes.collect::<Result<Vec<u32>, _>>()?);
         raw.tags.push(pid);
     }
-    // Properties name elements of any dimension; `finish` keeps the names of skin (facet) tags.
-    raw.tag_names = names.into_iter().map(|(pid, name)| (2, pid, name)).collect();
+    // A property may name triangles or tets; `finish` keeps the names of the tags in use.
+    raw.tag_names = (names.into_iter()).flat_map(|(pid, name)| [(2, pid, name.clone()), (3, pid, name)]).collect();
     if !complete {
         let message = format!("no ENDDATA after line {}: the file is truncated", lines.line);
         return Err(MeshError::Format { path: path.to_owned(), message });
@@ -172,10 +172,11 @@ pub(super) fn write<const D: usize>(
     let names: BTreeMap<i32, &str> = (data.facet_names.iter())
         // `tagged_facets` sorts the skin by tag.
         .filter(|(tag, _)| skin.binary_search_by_key(*tag, |(_, t)| *t).is_ok())
+        .chain(data.domain_name.iter().map(|name| (&solid, name)))
         .map(|(&tag, name)| {
             if name.contains(['"', ';', '\n', '\r']) {
                 let message = format!(
-                    "facet group name {name:?} cannot be a NASTRAN property's name comment (no quotes, semicolons or line breaks)"
+                    "group name {name:?} cannot be a NASTRAN property's name comment (no quotes, semicolons or line breaks)"
                 );
                 return Err(MeshError::Format { path: path.to_owned(), message });
             }
@@ -221,23 +222,24 @@ fn write_body<const D: usize>(
     for (k, (facet, tag)) in skin.iter().enumerate() {
         write_element(facet_card, elements + k + 1, *tag, &nodes.facet(facet))?;
     }
-    if D == 3 {
-        writeln!(w, "PSOLID,{solid},1")?;
-    } else {
-        writeln!(w, "PSHELL,{solid},1,1.")?;
-    }
     let mut tags: Vec<i32> = skin.iter().map(|&(_, t)| t).collect();
     tags.dedup();
+    let solid_card = if D == 3 { "PSOLID" } else { "PSHELL" };
+    let properties = std::iter::once((solid, solid_card)).chain(tags.into_iter().map(|tag| (tag, "PSHELL")));
     // Each pre-processor's own way: HyperMesh's before the card, ANSA's at the end of the model.
-    for tag in tags {
-        if let Some(name) = names.get(&tag) {
-            writeln!(w, "$HMNAME PROP {tag} \"{name}\"")?;
+    let mut ansa = String::new();
+    for (pid, card) in properties {
+        if let Some(name) = names.get(&pid) {
+            writeln!(w, "$HMNAME PROP {pid} \"{name}\"")?;
+            ansa.push_str(&format!("$ANSA_NAME_COMMENT;{pid};{card};{name};;NO;NO;NO;NO;\n"));
         }
-        writeln!(w, "PSHELL,{tag}")?;
+        match (pid == solid, D) {
+            (true, 3) => writeln!(w, "PSOLID,{pid},1")?,
+            (true, _) => writeln!(w, "PSHELL,{pid},1,1.")?,
+            (false, _) => writeln!(w, "PSHELL,{pid}")?,
+        }
     }
-    for (tag, name) in names {
-        writeln!(w, "$ANSA_NAME_COMMENT;{tag};PSHELL;{name};;NO;NO;NO;NO;")?;
-    }
+    w.write_all(ansa.as_bytes())?;
     writeln!(w, "ENDDATA")
 }
 
@@ -427,6 +429,7 @@ GRID          99            junk\r\n";
     fn names_skin_properties_in_both_pre_processors_comments() {
         let (mesh, mut data) = tagged_cube();
         data.facet_names = BTreeMap::from([(4, "bolt seat".into()), (9, "weld-2".into()), (12, "unused".into())]);
+        data.domain_name = Some("bracket".into());
         let path = Path::new("cube.nas");
         let mut bytes = Vec::new();
         write(&Nodes::new(&mesh, ElementOrder::Linear), &data, &mut bytes, path).unwrap();
@@ -435,6 +438,8 @@ GRID          99            junk\r\n";
             "$HMNAME PROP 4 \"bolt seat\"\nPSHELL,4\n",
             "$HMNAME PROP 9 \"weld-2\"\nPSHELL,9\n",
             "$ANSA_NAME_COMMENT;4;PSHELL;bolt seat;;NO;NO;NO;NO;\n",
+            "$HMNAME PROP 11 \"bracket\"\nPSOLID,11,1\n",
+            "$ANSA_NAME_COMMENT;11;PSOLID;bracket;;NO;NO;NO;NO;\n$ANSA_NAME_COMMENT;4;PSHELL;bolt seat;;NO;NO;NO;NO;\n",
             "$ANSA_NAME_COMMENT;9;PSHELL;weld-2;;NO;NO;NO;NO;\nENDDATA",
         ] {
             assert!(text.contains(line), "{line:?} in\n{text}");
@@ -442,6 +447,7 @@ GRID          99            junk\r\n";
         assert!(!text.contains("unused"), "a name without facets is not written");
         let (_, back) = read(path, &bytes).unwrap().finish::<3>(path).unwrap();
         assert_eq!(back.facet_names, BTreeMap::from([(4, "bolt seat".into()), (9, "weld-2".into())]));
+        assert_eq!(back.domain_name.as_deref(), Some("bracket"));
         // The untagged rest of the boundary (PSHELL 10) stays unnamed.
         assert_eq!(back.facet_tags.values().filter(|&&t| t == 10).count(), 9);
         for bad in ["a;b", "say \"hi\"", "two\nlines"] {
@@ -468,6 +474,10 @@ GRID          99            junk\r\n";
                     $ANSA_NAME_COMMENT;375;MAT1;steel;;NO;NO;NO;\n\
                     $HMNAME PROP 375 \"first\"\n$ANSA_NAME_COMMENT;375;PSHELL;second;;";
         assert_eq!(named(both), skin("second"));
+        let path = Path::new("named.nas");
+        let solid = TWO_TETS.replacen("BEGIN BULK", "BEGIN BULK\n$ANSA_NAME_COMMENT;374;PSOLID;Part 1_Volume_375;;", 1);
+        let data = read(path, solid.as_bytes()).unwrap().finish::<3>(path).unwrap().1;
+        assert_eq!((data.domain_name.as_deref(), data.facet_names), (Some("Part 1_Volume_375"), BTreeMap::new()));
         // Comments cut short or malformed name nothing, and the deck still reads.
         for comment in [
             "$ANSA_NAME_COMMENT;375;PSHELL;a name wrapped at column eighty without its",
@@ -578,8 +588,10 @@ GRID,3,,0.,1.,0.\nGRID,4,,0.,0.,1.\nGRID,5,,1.,1.,1.\nCTETRA,1,1,1,2,3,4\nCTETRA
                     s.spawn(move || {
                         let (mesh, data) = crate::read_mesh_with_data::<3>(path).unwrap_or_else(|e| panic!("{e}"));
                         assert!(mesh.volumes().iter().all(|&v| v > 0.0), "{}", path.display());
-                        // ANSA names each part's one skin property.
+                        // ANSA names each part's one skin property and its solid's.
                         assert_eq!(data.facet_names.values().collect::<Vec<_>>(), ["Part 1"], "{}", path.display());
+                        let solid = data.domain_name.unwrap_or_default();
+                        assert!(solid.starts_with("Part 1_Volume_"), "{}: {solid}", path.display());
                         mesh.num_elements()
                     })
                 })

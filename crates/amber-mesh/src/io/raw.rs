@@ -89,6 +89,11 @@ impl RawMesh {
         &self.nodes[if i == 0 { 0 } else { self.ends[i - 1] }..self.ends[i]]
     }
 
+    /// Cell `i`'s tag (0: none).
+    fn tag(&self, i: usize) -> i32 {
+        self.tags.get(i).copied().unwrap_or(0)
+    }
+
     /// The highest dimension of the cells (0 without cells).
     pub(super) fn dimension(&self) -> usize {
         self.kinds.iter().map(|k| k.dim).max().unwrap_or(0)
@@ -99,7 +104,8 @@ impl RawMesh {
     /// `D`-simplices with their cell data (a quadratic one as the linear simplex of its corners,
     /// counted in [`MeshData::linearised`]), records tagged `(D-1)`-simplices as facet tags and
     /// counts every other cell (untagged facets among them) in [`MeshData::dropped`]; the names
-    /// of the `(D-1)`-dimensional tags some facet carries become [`MeshData::facet_names`].
+    /// of the `(D-1)`-dimensional tags some facet carries become [`MeshData::facet_names`], and the
+    /// name of the `D`-dimensional tag every kept simplex carries [`MeshData::domain_name`].
     pub(super) fn finish<const D: usize>(self, path: &Path) -> Result<(Mesh<D>, MeshData), MeshError> {
         let found = self.dimension();
         if found != D {
@@ -134,7 +140,7 @@ impl RawMesh {
                 }
                 continue;
             }
-            let tag = self.tags.get(i).copied().unwrap_or(0);
+            let tag = self.tag(i);
             if kind.dim + 1 == D && kind.node_counts().is_some() && tag != 0 {
                 let mut facet = corners.to_vec();
                 facet.sort_unstable();
@@ -142,6 +148,11 @@ impl RawMesh {
             } else {
                 *data.dropped.entry(kind.name.to_owned()).or_default() += 1;
             }
+        }
+        let domain_tags: std::collections::BTreeSet<i32> = kept.iter().map(|&i| self.tag(i)).collect();
+        if let [tag] = domain_tags.into_iter().collect::<Vec<_>>()[..] {
+            data.domain_name =
+                (self.tag_names.iter()).find(|(dim, t, _)| *dim == D && *t == tag).map(|(.., n)| n.clone());
         }
         let used: std::collections::BTreeSet<i32> = data.facet_tags.values().copied().collect();
         data.facet_names = (self.tag_names.into_iter())
