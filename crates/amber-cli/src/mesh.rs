@@ -384,7 +384,7 @@ where
     let last = &generated.last().expect("at least one step").mesh;
     // The boundary grouped by CAD face, for a solver's boundary conditions.
     let facet_tags = domain.boundary_tags(last);
-    let facet_names = domain.boundary_names();
+    let (facet_names, domain_name) = (domain.boundary_names(), domain.domain_name());
     let scored = expert.map(|(mesh, path)| WithExpert::new(domain, mesh, &path)).transpose()?;
     let reference = scored.as_ref().map(|p| Reference::new(p, model.limits())).transpose()?;
     let metrics: Vec<Option<MeshMetrics>> = generated
@@ -399,7 +399,7 @@ where
     }
     // Where the final mesh is coarser (> 0) or finer than the expert's, for a viewer.
     let log_ratios = scored.as_ref().map(|p| log_size_ratios(last, &p.expert_mesh));
-    let mut data = MeshData { facet_tags, facet_names, ..MeshData::new() };
+    let mut data = MeshData { facet_tags, facet_names, domain_name, ..MeshData::new() };
     if let Some(ratios) = &log_ratios {
         data = data.with_cell("log_size_ratio_to_expert", ratios.clone());
     }
@@ -593,8 +593,8 @@ fn mesh_solid_with(
     let params = Mesh3dParams::default().with_max_elements(args.max_elements);
     let mesh = generate_3d(&surface, field, &params).context("mesh generation failed")?;
     let facet_tags = cad_face_tags(&SurfaceDistance::new(&surface), &mesh);
-    let facet_names = surface.face_names().clone();
-    write_output(&mesh, args, MeshData { facet_tags, facet_names, ..MeshData::new() })?;
+    let (facet_names, domain_name) = (surface.face_names().clone(), surface.solid_name().map(str::to_owned));
+    write_output(&mesh, args, MeshData { facet_tags, facet_names, domain_name, ..MeshData::new() })?;
     let report = QualityReport::measure(&mesh, field);
     Ok((mesh, report))
 }

@@ -104,7 +104,8 @@ fn meshes_a_solid_to_a_field_given_as_a_tet_mesh() {
 }
 
 /// The names a geometry gives its faces (here an OBJ's groups) name the written mesh's boundary
-/// groups: gmsh physical groups in `.msh`, node sets and surfaces in `.inp`.
+/// groups: gmsh physical groups in `.msh`, node sets and surfaces in `.inp`; a mesh file as the
+/// geometry also names the new mesh's element group.
 #[test]
 fn names_the_boundary_groups_as_the_geometry_names_its_faces() {
     let dir = tempfile::tempdir().unwrap();
@@ -128,7 +129,17 @@ fn names_the_boundary_groups_as_the_geometry_names_its_faces() {
     // `amber convert` carries the names from format to format.
     let converted = dir.path().join("converted.inp");
     assert!(amber().arg("convert").arg(&msh).arg(&converted).status().unwrap().success());
-    assert!(std::fs::read_to_string(&converted).unwrap().contains("*NSET, NSET=top\n"));
+    let text = std::fs::read_to_string(&converted).unwrap();
+    assert!(text.contains("*NSET, NSET=top\n"));
+    // An Abaqus part as the geometry: its faces and its element set, which a deck's section
+    // assignment names, carry over to the new mesh.
+    let part = dir.path().join("bracket.inp");
+    std::fs::write(&part, text.replace("ELSET=domain\n", "ELSET=BRACKET\n")).unwrap();
+    let remeshed = dir.path().join("remeshed.inp");
+    let output = amber().arg("mesh").arg(&part).args(["--size", "0.25", "-o"]).arg(&remeshed).output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let text = std::fs::read_to_string(&remeshed).unwrap();
+    assert!(text.contains(", ELSET=BRACKET\n") && text.contains("*NSET, NSET=\"side walls\"\n"), "{text}");
 }
 
 /// Several geometries in one command: each meshed to the output with `{stem}` replaced; one

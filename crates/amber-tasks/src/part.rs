@@ -49,6 +49,7 @@ pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) ->
         None => match read_any_mesh(path).map_err(|e| unreadable(path, e, "neither a surface nor a tet mesh: "))? {
             AnyMesh::Three(mesh, data) => {
                 solid_surface_of_mesh(path, &mesh, &data.facet_tags, data.facet_names, feature_angle)
+                    .map(|surface| surface.with_solid_name(data.domain_name))
             }
             AnyMesh::Two(..) => Err(geometry("holds triangles (a 2D geometry), not a solid".into())),
         },
@@ -302,6 +303,10 @@ impl Domain<3> for SolidPart {
     fn boundary_names(&self) -> BTreeMap<i32, String> {
         self.surface.face_names().clone()
     }
+
+    fn domain_name(&self) -> Option<String> {
+        self.surface.solid_name().map(str::to_owned)
+    }
 }
 
 /// Every boundary triangle of `mesh` (a mesh of the solid `distance` measures), keyed by its
@@ -490,7 +495,8 @@ mod tests {
 
     /// A tet mesh given as the geometry keeps its file's boundary groups as its faces: z = 0 and
     /// z = 1 in group 7, the other four sides in group 3, two faces where a split at its edges
-    /// would make six; then meshing it tags its boundary with those groups.
+    /// would make six; then meshing it tags its boundary with those groups, and its elements
+    /// with the file's domain name.
     #[test]
     fn a_mesh_file_as_geometry_keeps_its_boundary_groups() {
         let part = unit_cube_part();
@@ -499,7 +505,8 @@ mod tests {
         let facet_tags = part.boundary_tags(mesh).into_iter().map(|(facet, face)| (facet, group(face))).collect();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("cube.msh");
-        let data = amber_mesh::MeshData { facet_tags, ..Default::default() }.with_facet_name(7, "ends");
+        let data = amber_mesh::MeshData { facet_tags, domain_name: Some("block".into()), ..Default::default() }
+            .with_facet_name(7, "ends");
         amber_mesh::write_mesh(mesh, &path, &data).unwrap();
 
         let surface = read_solid_surface(&path, FEATURE_ANGLE_DEGREES, 0.3).unwrap();
@@ -517,6 +524,7 @@ mod tests {
         let tags = remeshed.boundary_tags(&remeshed.initial_mesh);
         assert_eq!(tags.values().copied().collect::<std::collections::BTreeSet<_>>(), [3, 7].into());
         assert_eq!(remeshed.boundary_names(), names);
+        assert_eq!(remeshed.domain_name().as_deref(), Some("block"));
     }
 
     /// Every element of an L-shaped plate gets the geometry inputs, no element is farther from

@@ -77,6 +77,10 @@ pub trait Domain<const D: usize>: Sync {
     fn boundary_names(&self) -> BTreeMap<i32, String> {
         BTreeMap::new()
     }
+    /// The name of the domain's element group where the geometry gives one (a mesh file's).
+    fn domain_name(&self) -> Option<String> {
+        None
+    }
 }
 
 /// One problem of a learning task in `D` dimensions: a domain with the expert's mesh of it.
@@ -135,6 +139,10 @@ impl<const D: usize, P: Domain<D>> Domain<D> for WithExpert<P, D> {
 
     fn boundary_names(&self) -> BTreeMap<i32, String> {
         self.domain.boundary_names()
+    }
+
+    fn domain_name(&self) -> Option<String> {
+        self.domain.domain_name()
     }
 }
 

@@ -29,6 +29,8 @@ pub struct Surface {
     face_ids: Vec<i32>,
     /// Names of face ids, where the geometry gives them.
     face_names: BTreeMap<i32, String>,
+    /// The name of the solid the surface bounds, where the geometry gives one.
+    solid_name: Option<String>,
     /// Whether [`Surface::validate`] succeeded (nothing can change the surface afterwards).
     valid: bool,
 }
@@ -149,7 +151,7 @@ impl Surface {
                 });
             }
         }
-        Ok(Self { vertices, triangles, face_ids, face_names: BTreeMap::new(), valid: false })
+        Ok(Self { vertices, triangles, face_ids, face_names: BTreeMap::new(), solid_name: None, valid: false })
     }
 
     /// Builds a surface from a triangle soup (3 corners per triangle, as in STL), merging
@@ -323,6 +325,18 @@ impl Surface {
     /// Names of face ids, where the geometry gives them.
     pub fn face_names(&self) -> &BTreeMap<i32, String> {
         &self.face_names
+    }
+
+    /// The surface as the boundary of the solid called `name` (a mesh file's domain group),
+    /// which meshes of it give their element group.
+    pub fn with_solid_name(mut self, name: Option<String>) -> Self {
+        self.solid_name = name;
+        self
+    }
+
+    /// The name of the solid the surface bounds, where the geometry gives one.
+    pub fn solid_name(&self) -> Option<&str> {
+        self.solid_name.as_deref()
     }
 
     /// Signed enclosed volume (divergence theorem; positive for a closed outward surface).
