@@ -8,7 +8,7 @@ use amber_plot::{Bar, Series, Tile, bar_chart, line_chart};
 use crate::method::MethodSpec;
 use crate::report::{write_atomic, write_json};
 use crate::results::{ExperimentResults, RunResult};
-use crate::table::{self, PaperNumber};
+use crate::table::{self, PaperNumber, mean};
 
 /// A column of the experiment (a Poisson difficulty, or the Console task) and its caption.
 pub(crate) struct Setting {
@@ -112,9 +112,4 @@ fn gallery_steps(steps: usize) -> Vec<usize> {
     let mut chosen: Vec<usize> = [0, 1, steps.saturating_sub(1)].into_iter().filter(|&t| t < steps).collect();
     chosen.dedup();
     chosen
-}
-
-fn mean(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    sum / n.max(1) as f64
 }

@@ -41,7 +41,8 @@ pub fn row_label(run: &RunResult) -> String {
     }
 }
 
-fn mean(values: impl Iterator<Item = f64>) -> f64 {
+/// The mean of `values` over seeds or problems (0 for none).
+pub(crate) fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     sum / n.max(1) as f64
 }
@@ -64,11 +65,12 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
         md,
         "# {} — profile `{}`\n\nNormalised DCD after the last generation step on {} (lower is better; \
          0 = as good as re-meshing with the expert's own sizing field, 1 = no better than M⁰): mean over problems \
-         [25 %, 75 % quantiles], averaged over {seeds} seed(s). *Paper* is the paper's number (mean of 4 seeds) where \
-         it gives one.\n",
+         [25 %, 75 % quantiles], averaged over {seeds} seed(s){}. *Paper* is the paper's number (mean of 4 seeds) \
+         where it gives one.\n",
         results.experiment,
         results.profile,
-        results.evaluated_on()
+        results.evaluated_on(),
+        if seeds > 1 { ", each seed's own mean after it" } else { "" }
     );
     if results.config["experiment"]["scale_to_budget"] == true {
         md.push_str(
@@ -93,11 +95,16 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
                 Some(runs) => {
                     let _ = write!(
                         md,
-                        " {:.3} [{:.3}, {:.3}] |",
+                        " {:.3} [{:.3}, {:.3}]",
                         mean(runs.iter().map(|r| r.ndcd)),
                         mean(runs.iter().map(|r| r.ndcd_quantiles[0])),
                         mean(runs.iter().map(|r| r.ndcd_quantiles[1]))
                     );
+                    if runs.len() > 1 {
+                        let by_seed: Vec<String> = runs.iter().map(|r| format!("{:.3}", r.ndcd)).collect();
+                        let _ = write!(md, " (seeds {})", by_seed.join(", "));
+                    }
+                    md.push_str(" |");
                 }
                 None => md.push_str(" – |"),
             }
@@ -157,7 +164,11 @@ mod tests {
     use crate::results::{ProblemEvaluation, RunKey, StepEvaluation};
 
     fn problem(elements: usize, expert_elements: usize) -> ProblemEvaluation {
-        let metrics = MeshMetrics { dcd: 0.1, normalised_dcd: 0.1, chamfer: 0.0, volume_difference: 0.0, elements };
+        scored(elements, expert_elements, 0.1)
+    }
+
+    fn scored(elements: usize, expert_elements: usize, normalised_dcd: f64) -> ProblemEvaluation {
+        let metrics = MeshMetrics { dcd: 0.1, normalised_dcd, chamfer: 0.0, volume_difference: 0.0, elements };
         ProblemEvaluation {
             name: None,
             expert_sha256: None,
@@ -169,9 +180,8 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_element_ratio_column_spans_every_problem_of_every_seed() {
-        let key = |seed| RunKey {
+    fn key(seed: usize) -> RunKey<'static> {
+        RunKey {
             method: "amber",
             variant: "default",
             difficulty: "console",
@@ -179,7 +189,25 @@ mod tests {
             train_seconds: 0.0,
             eval_seconds: 0.0,
             threads: Default::default(),
-        };
+        }
+    }
+
+    #[test]
+    fn a_cell_of_several_seeds_shows_each_seeds_mean() {
+        let runs = vec![
+            RunResult::new(key(0), &[scored(10, 10, 0.1), scored(10, 10, 0.2)]),
+            RunResult::new(key(1), &[scored(10, 10, 0.3), scored(10, 10, 0.4)]),
+        ];
+        let results = ExperimentResults::new("console", "quick", serde_json::json!({}), runs);
+        let md = markdown(&results, &|_, _| Some(0.196));
+        assert!(md.contains("| amber | 0.250 [0.225, 0.275] (seeds 0.150, 0.350) | 0.196 |"), "{md}");
+        assert!(md.contains("averaged over 2 seed(s), each seed's own mean after it."), "{md}");
+        let one = ExperimentResults::new("console", "quick", serde_json::json!({}), results.runs[..1].to_vec());
+        assert!(markdown(&one, &|_, _| None).contains("| amber | 0.150 [0.125, 0.175] | – |"));
+    }
+
+    #[test]
+    fn the_element_ratio_column_spans_every_problem_of_every_seed() {
         let first = RunResult::new(key(0), &[problem(90, 100), problem(300, 200)]);
         let second = RunResult::new(key(1), &[problem(50, 100)]);
         assert_eq!(element_ratios(&[&first, &second]), "0.90 [0.50, 1.50]");
