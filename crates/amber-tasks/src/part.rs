@@ -31,7 +31,8 @@ pub const FEATURE_ANGLE_DEGREES: f64 = 30.0;
 /// of a tet mesh in any format amber reads (its faces the file's boundary groups). A surface
 /// with a single face (a plain STL, a mesh boundary without groups) is split into faces at
 /// edges sharper than `feature_angle` degrees, since the generator keeps vertices on their own
-/// face and curves.
+/// face and curves. The solid's name is a mesh file's domain group's, or the name of a surface's
+/// single face (an STL of one `solid NAME`, as CAD exporters write a part).
 pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) -> Result<Surface, TaskError> {
     let geometry = |message: String| TaskError::Geometry { path: path.into(), message };
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
@@ -42,9 +43,16 @@ pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) ->
     };
     match soup {
         Some(soup) => {
-            let surface =
-                Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0).map_err(|e| geometry(e.to_string()))?;
-            validated_solid(path, surface.with_face_names(soup.face_names), feature_angle)
+            let surface = Surface::from_triangle_soup(&soup.corners, soup.face_ids, 0.0)
+                .map_err(|e| geometry(e.to_string()))?
+                .with_face_names(soup.face_names);
+            // One named face is a CAD exporter's `solid PART` (an OBJ's one group): the name of
+            // the part, whose pieces after the split at feature edges get numbers.
+            let single_face_name = match surface.face_ids() {
+                [first, rest @ ..] if rest.iter().all(|id| id == first) => surface.face_names().get(first).cloned(),
+                _ => None,
+            };
+            validated_solid(path, surface, feature_angle).map(|surface| surface.with_solid_name(single_face_name))
         }
         None => match read_any_mesh(path).map_err(|e| unreadable(path, e, "neither a surface nor a tet mesh: "))? {
             AnyMesh::Three(mesh, data) => {
@@ -525,6 +533,43 @@ mod tests {
         assert_eq!(tags.values().copied().collect::<std::collections::BTreeSet<_>>(), [3, 7].into());
         assert_eq!(remeshed.boundary_names(), names);
         assert_eq!(remeshed.domain_name().as_deref(), Some("block"));
+    }
+
+    /// An STL of one named solid, as a CAD exporter writes a part, names the solid: its faces
+    /// after the split at feature edges are numbered, and meshes of it put their elements in a
+    /// group of the part's name. Two named solids are two faces, and name no solid.
+    #[test]
+    fn a_single_named_stl_solid_names_the_part() {
+        let cube = unit_cube_part().surface;
+        let dir = tempfile::tempdir().unwrap();
+        // The cube's faces in one solid per name, face f in solid f mod `names.len()`.
+        let read_stl = |names: &[&str]| {
+            let mut text = String::new();
+            for (solid, name) in names.iter().enumerate() {
+                text += &format!("solid {name}\n");
+                for (triangle, _) in
+                    cube.triangles().iter().zip(cube.face_ids()).filter(|&(_, &f)| f as usize % names.len() == solid)
+                {
+                    text += "facet normal 0 0 0\nouter loop\n";
+                    for &[x, y, z] in triangle.map(|i| cube.vertices()[i as usize]).iter() {
+                        text += &format!("vertex {x} {y} {z}\n");
+                    }
+                    text += "endloop\nendfacet\n";
+                }
+                text += &format!("endsolid {name}\n");
+            }
+            let path = dir.path().join(format!("{}.stl", names.len()));
+            std::fs::write(&path, text).unwrap();
+            read_solid_surface(&path, FEATURE_ANGLE_DEGREES, 0.3).unwrap()
+        };
+        let one = read_stl(&["Bracket"]);
+        assert_eq!(one.solid_name(), Some("Bracket"));
+        assert_eq!(one.face_ids().iter().collect::<std::collections::BTreeSet<_>>().len(), 6);
+        assert!(one.face_names().is_empty(), "{:?}", one.face_names());
+        assert_eq!(SolidPart::new("cube".into(), one, 0.3).unwrap().domain_name().as_deref(), Some("Bracket"));
+        let two = read_stl(&["even", "odd"]);
+        assert_eq!(two.solid_name(), None);
+        assert_eq!(two.face_names().values().map(String::as_str).collect::<Vec<_>>(), ["even", "odd"]);
     }
 
     /// Every element of an L-shaped plate gets the geometry inputs, no element is farther from
