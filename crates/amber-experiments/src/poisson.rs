@@ -97,10 +97,14 @@ impl PoissonExperiment {
     /// Writes `results/ablate/`.
     pub fn ablation(profile: Profile) -> Self {
         let mut experiment = Self::new(profile);
-        // The ablations vary the paper's choices on the paper's network and inputs: without the
-        // graph context and the error-indicator feature of the quick profile.
-        experiment.overrides =
-            serde_json::json!({ "network": { "graph_context": false }, "inputs": [LOG_SIZE_COLUMN] });
+        // The ablations vary the paper's choices on the paper's network, inputs and rollouts:
+        // without the graph context, the error-indicator feature and the final step scale of the
+        // quick profile.
+        experiment.overrides = serde_json::json!({
+            "network": { "graph_context": false },
+            "inputs": [LOG_SIZE_COLUMN],
+            "calibrate_element_count": false,
+        });
         if profile == Profile::Quick {
             // Seventeen runs in three hours on two cores: each AMBER run gets 600 of the
             // reproduction's 2,500 steps (4–5 min of training on Poisson hard); the 256² CNNs
