@@ -31,7 +31,8 @@ pub struct TrainingArgs {
     profile: Profile,
     /// amber-mean or amber-max: how the expert's sizes become labels on a coarser mesh. Max,
     /// the default, meshes Console's validation parts better (normalised DCD 0.167 against
-    /// 0.222, results/console) and Poisson as well (0.119 against 0.118).
+    /// 0.222, results/console) and Poisson about as well (0.135 against 0.133, two seeds,
+    /// results/poisson).
     #[arg(long, default_value = "amber-max")]
     pub method: Method,
     /// Training seed: selects the training problems and seeds the run.
