@@ -48,10 +48,7 @@ pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) ->
                 .with_face_names(soup.face_names);
             // One named face is a CAD exporter's `solid PART` (an OBJ's one group): the name of
             // the part, whose pieces after the split at feature edges get numbers.
-            let single_face_name = match surface.face_ids() {
-                [first, rest @ ..] if rest.iter().all(|id| id == first) => surface.face_names().get(first).cloned(),
-                _ => None,
-            };
+            let single_face_name = single_face(&surface).and_then(|face| surface.face_names().get(&face).cloned());
             validated_solid(path, surface, feature_angle).map(|surface| surface.with_solid_name(single_face_name))
         }
         None => match read_any_mesh(path).map_err(|e| unreadable(path, e, "neither a surface nor a tet mesh: "))? {
@@ -90,13 +87,21 @@ pub(crate) fn solid_surface_of_mesh(
 
 /// `surface` (from `path`) split at feature edges when it has a single face, and validated.
 fn validated_solid(path: &Path, mut surface: Surface, feature_angle: f64) -> Result<Surface, TaskError> {
-    if surface.face_ids().iter().all(|&id| id == surface.face_ids()[0]) {
+    if single_face(&surface).is_some() {
         surface.split_faces_at_feature_edges(feature_angle);
     }
     surface
         .validate()
         .map_err(|e| TaskError::Geometry { path: path.into(), message: format!("does not bound a solid: {e}") })?;
     Ok(surface)
+}
+
+/// The one face of a surface whose triangles all lie on the same face.
+fn single_face(surface: &Surface) -> Option<i32> {
+    match surface.face_ids() {
+        [first, rest @ ..] if rest.iter().all(|id| id == first) => Some(*first),
+        _ => None,
+    }
 }
 
 /// A planar domain from a geometry file: a polygon JSON `{"outer": [[x, y], ...], "holes":
