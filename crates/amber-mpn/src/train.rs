@@ -1,12 +1,13 @@
 //! Training the network behind plain slices: [`MpnTrainer`] owns the network, its variables and
 //! the Adam optimiser, and takes one step (training-mode forward, the objective's mean squared
-//! error, backward, clipping, update) on a [`GraphBatch`] and its targets.
+//! error, backward, clipping, update) on a [`GraphBatch`] and its targets. It may also keep a
+//! moving average of the weights, the network it then hands to inference.
 
 use std::path::Path;
 
 use amber_graph::GraphBatch;
 use amber_nn::{Adam, Backend, Objective};
-use candle_core::{DType, Device, Tensor};
+use candle_core::{DType, Device, Tensor, Var};
 use candle_nn::VarMap;
 use rand::Rng;
 
@@ -32,6 +33,32 @@ pub struct MpnTrainer {
     varmap: VarMap,
     objective: Objective,
     optimiser: Adam,
+    average: Option<WeightAverage>,
+}
+
+/// An exponential moving average of the trained weights (Polyak averaging): after update t,
+/// `average ← d·average + (1 − d)·weights` with `d = min(decay, (1 + t) / (10 + t))`, so that the
+/// early average follows the fast-moving weights instead of remembering the initialisation.
+struct WeightAverage {
+    decay: f64,
+    network: Mpn,
+    varmap: VarMap,
+}
+
+impl WeightAverage {
+    fn update(&self, weights: &VarMap, step: u64) -> candle_core::Result<()> {
+        let decay = self.decay.min((1 + step) as f64 / (10 + step) as f64);
+        let (weights, average) = (lock(weights)?, lock(&self.varmap)?);
+        for (name, var) in average.iter() {
+            let Some(w) = weights.get(name) else { candle_core::bail!("no trained weight `{name}`") };
+            var.set(&((var.as_tensor() * decay)? + (w.as_tensor() * (1.0 - decay))?)?)?;
+        }
+        Ok(())
+    }
+}
+
+fn lock(varmap: &VarMap) -> candle_core::Result<std::sync::MutexGuard<'_, std::collections::HashMap<String, Var>>> {
+    varmap.data().lock().map_err(|_| candle_core::Error::Msg("poisoned variable map".into()))
 }
 
 impl MpnTrainer {
@@ -48,7 +75,7 @@ impl MpnTrainer {
         let device = backend.device()?;
         let (network, varmap) = Mpn::init(config, seed, DType::F32, &device)?;
         let optimiser = Adam::new(&varmap, max_grad_norm)?;
-        Ok(Self { network, device, varmap, objective, optimiser })
+        Ok(Self { network, device, varmap, objective, optimiser, average: None })
     }
 
     /// The network of a checkpoint written by [`Self::save`], on `backend`, with fresh moments.
@@ -56,7 +83,40 @@ impl MpnTrainer {
         let device = backend.device()?;
         let (network, varmap) = Mpn::load_trainable(weights, &device)?;
         let optimiser = Adam::new(&varmap, max_grad_norm)?;
-        Ok(Self { network, device, varmap, objective, optimiser })
+        Ok(Self { network, device, varmap, objective, optimiser, average: None })
+    }
+
+    /// Keeps a moving average of the weights with `decay` per update (see `WeightAverage`),
+    /// starting from the current weights, or from the average saved at `saved` (by
+    /// [`Self::save`], to resume); the average is then the network of [`Self::inference_network`]
+    /// and [`Self::save`].
+    pub fn with_weight_average(mut self, decay: f64, saved: Option<&Path>) -> Result<Self> {
+        if !(0.0..1.0).contains(&decay) {
+            return Err(MpnError::InvalidConfig(format!("weight average decay {decay} is not in [0, 1)")));
+        }
+        let (network, varmap) = match saved {
+            Some(path) => {
+                let (network, varmap) = Mpn::load_trainable(path, &self.device)?;
+                if network.config() != self.network.config() {
+                    let message = "a weight average of another network".into();
+                    return Err(MpnError::Checkpoint { path: path.into(), message });
+                }
+                (network, varmap)
+            }
+            None => {
+                let (network, varmap) = Mpn::init(self.network.config().clone(), 0, DType::F32, &self.device)?;
+                let weights = lock(&self.varmap)?;
+                for (name, var) in lock(&varmap)?.iter() {
+                    let w = weights
+                        .get(name)
+                        .ok_or_else(|| candle_core::Error::Msg(format!("no trained weight `{name}`")))?;
+                    var.set(w.as_tensor())?;
+                }
+                (network, varmap)
+            }
+        };
+        self.average = Some(WeightAverage { decay, network, varmap });
+        Ok(self)
     }
 
     /// Restores the moments written by [`Self::save_optimiser`] and the count of updates taken.
@@ -67,6 +127,12 @@ impl MpnTrainer {
     /// The network (sharing the trained variables).
     pub fn network(&self) -> &Mpn {
         &self.network
+    }
+
+    /// The network inference should use: the weight average when the trainer keeps one, else
+    /// the trained network.
+    pub fn inference_network(&self) -> &Mpn {
+        self.average.as_ref().map_or(&self.network, |a| &a.network)
     }
 
     /// Optimiser updates taken so far.
@@ -92,11 +158,23 @@ impl MpnTrainer {
         let squared_errors = squared_errors.to_vec1::<f32>()?;
         let loss_value = f64::from(loss.to_scalar::<f32>()?);
         let grad_norm = self.optimiser.step(&loss, lr)?;
+        if let Some(average) = &self.average {
+            average.update(&self.varmap, self.optimiser.steps())?;
+        }
         Ok(StepLoss { loss: loss_value, squared_errors, grad_norm })
     }
 
-    /// Saves the network as [`Mpn::save`] does.
+    /// Saves the inference network ([`Self::inference_network`]) as [`Mpn::save`] does.
     pub fn save(&self, weights: &Path) -> Result<()> {
+        match &self.average {
+            Some(average) => average.network.save(&average.varmap, weights),
+            None => self.save_trained(weights),
+        }
+    }
+
+    /// Saves the trained network as [`Mpn::save`] does (with a weight average, what resuming
+    /// needs beside [`Self::save`]'s file).
+    pub fn save_trained(&self, weights: &Path) -> Result<()> {
         self.network.save(&self.varmap, weights)
     }
 

@@ -137,6 +137,12 @@ fn a_resumed_run_in_random_orientations_continues_exactly() {
     });
 }
 
+/// The checkpoint holds the weight average (the model) and the trained weights beside it.
+#[test]
+fn a_resumed_run_with_a_weight_average_continues_exactly() {
+    resumes_exactly(TrainingConfig { checkpoint_interval: 7, weight_average_decay: Some(0.9), ..tiny_config(20) });
+}
+
 fn resumes_exactly(config: TrainingConfig) {
     let dir = tempfile::tempdir().unwrap();
     let (whole, killed) = (dir.path().join("whole"), dir.path().join("killed"));
@@ -164,6 +170,9 @@ fn resumes_exactly(config: TrainingConfig) {
     for ((step, la), (_, lb)) in a.iter().zip(&b) {
         assert!((la - lb).abs() <= 1e-6 * la.abs().max(1.0), "step {step}: {la} vs {lb}");
     }
+    // The same model, byte for byte.
+    let weights = |run: &Path| std::fs::read(run.join(MODEL_DIR).join("model.safetensors")).unwrap();
+    assert!(weights(&whole) == weights(&killed), "the resumed run's model differs");
     // Only the newest checkpoint is kept, and it names the final step.
     let latest = amber_train::latest_checkpoint(&killed).unwrap().unwrap();
     assert!(latest.ends_with("step-00000020"), "{latest:?}");

@@ -61,6 +61,11 @@ pub struct TrainingConfig {
     pub lr_schedule: LrSchedule,
     /// Global gradient-norm clip.
     pub max_grad_norm: Option<f64>,
+    /// Keep an exponential moving average of the weights with this decay per step (Polyak
+    /// averaging, `amber_mpn::MpnTrainer::with_weight_average`): the average is the model that
+    /// fills the buffer, validates and is written; off in the paper.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weight_average_decay: Option<f64>,
     /// Node budget of one batch (least-used graphs first, stop at the first that does not fit).
     pub batch_nodes: usize,
     /// Generated meshes kept in the FIFO part of the buffer (protected entries not counted).
@@ -128,6 +133,7 @@ impl TrainingConfig {
             learning_rate: PAPER_LEARNING_RATE,
             lr_schedule: LrSchedule::Constant,
             max_grad_norm: Some(PAPER_MAX_GRAD_NORM),
+            weight_average_decay: None,
             batch_nodes: 400_000,
             buffer_capacity: 1_000,
             add_interval: 8,
@@ -221,6 +227,9 @@ impl TrainingConfig {
         }
         if self.max_grad_norm.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
             return bad("max_grad_norm must be positive");
+        }
+        if self.weight_average_decay.is_some_and(|d| !(0.0..1.0).contains(&d)) {
+            return bad("weight_average_decay must be in [0, 1)");
         }
         if self.batch_nodes == 0 || self.add_interval == 0 || self.checkpoint_interval == 0 {
             return bad("batch_nodes, add_interval and checkpoint_interval must be positive");

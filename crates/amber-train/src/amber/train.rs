@@ -127,8 +127,11 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             edge_features: features.edge_dim(D),
             network: config.network.clone(),
         };
-        let trainer =
+        let mut trainer =
             MpnTrainer::new(network_config, config.objective, config.seed, config.max_grad_norm, config.device)?;
+        if let Some(decay) = config.weight_average_decay {
+            trainer = trainer.with_weight_average(decay, None)?;
+        }
         let mut training = Self {
             buffer: ReplayBuffer::new(config.buffer_capacity),
             dropout_rng: seeded_stream(config.seed, 1),
@@ -174,8 +177,17 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             return Err(fail("the training problems differ from the checkpointed run's".into()));
         }
         state.check(problems.len()).map_err(fail)?;
-        let mut trainer =
-            MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.objective, config.max_grad_norm, config.device)?;
+        // With a weight average the model's weights are the average, the trained ones beside.
+        let mut trainer = match config.weight_average_decay {
+            None => MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.objective, config.max_grad_norm, config.device)?,
+            Some(decay) => MpnTrainer::load(
+                &dir.join(TRAINED_WEIGHTS_FILE),
+                config.objective,
+                config.max_grad_norm,
+                config.device,
+            )?
+            .with_weight_average(decay, Some(&dir.join(WEIGHTS_FILE)))?,
+        };
         let predictor = Predictor::read(&dir.join(super::model::PREDICTOR_FILE), trainer.network().config())?;
         trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
@@ -229,9 +241,10 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         self.additions
     }
 
-    /// The network (sharing the trained variables).
+    /// The network the run rolls out and writes: the weight average if the run keeps one, else
+    /// the trained network (sharing its variables).
     pub fn network(&self) -> &Mpn {
-        self.trainer.network()
+        self.trainer.inference_network()
     }
 
     /// Normalisers, target transform and limits.
@@ -314,7 +327,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             .expect("protected depth-0 entries are always eligible");
         let entry = self.buffer.get(source);
         let (problem, depth) = (entry.problem, entry.depth + 1);
-        let sizes = self.predictor.predict(self.trainer.network(), &[&entry.sample.state])?.pop().expect("one state");
+        let sizes = self.predictor.predict(self.network(), &[&entry.sample.state])?.pop().expect("one state");
         let outcome = generation_step(
             &self.problems[problem],
             &entry.sample.state.mesh,
@@ -376,7 +389,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             }
         }
         if self.config.calibrate_element_count {
-            let sizing = AmberSizing { network: self.trainer.network(), predictor: &self.predictor };
+            let sizing = AmberSizing { network: self.network(), predictor: &self.predictor };
             let scale = fit_final_step_scale(&sizing, &self.problems, self.config.inference_steps)?;
             self.predictor.limits.final_step_scale = scale;
         }
@@ -385,7 +398,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
 
     /// Rolls out the current model on `validation` (evaluation mode) and summarises.
     pub fn validate(&self, validation: &Evaluation<'_, D, P>) -> Result<EvaluationSummary> {
-        let sizing = AmberSizing { network: self.trainer.network(), predictor: &self.predictor };
+        let sizing = AmberSizing { network: self.network(), predictor: &self.predictor };
         Ok(validation.run(&sizing, self.config.inference_steps)?.1)
     }
 
@@ -414,11 +427,18 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         };
         checkpoint::commit(out_dir, self.step, self.buffer.entries(), |dir| {
             self.save_model(dir)?;
+            if self.config.weight_average_decay.is_some() {
+                self.trainer.save_trained(&dir.join(TRAINED_WEIGHTS_FILE))?;
+            }
             self.trainer.save_optimiser(&dir.join(OPTIMISER_FILE))?;
             Ok(write_json_atomic(&dir.join(STATE_FILE), &state)?)
         })
     }
 }
+
+/// The trained weights in a checkpoint of a run that keeps a weight average (whose
+/// [`WEIGHTS_FILE`] holds the average, the model).
+const TRAINED_WEIGHTS_FILE: &str = "trained.safetensors";
 
 /// The random stream of the batch graphs' orientations (after edge dropout's 1 and the buffer's 2).
 const ORIENTATION_STREAM: u64 = 3;
