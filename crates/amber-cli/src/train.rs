@@ -30,9 +30,9 @@ pub struct TrainingArgs {
     #[arg(long, default_value = "quick")]
     profile: Profile,
     /// amber-mean or amber-max: how the expert's sizes become labels on a coarser mesh. Max,
-    /// the default, meshes Console's validation parts better (normalised DCD 0.167 against
-    /// 0.222, results/console) and Poisson about as well (0.135 against 0.133, two seeds,
-    /// results/poisson).
+    /// the default, varies less between training seeds on Console's validation parts
+    /// (normalised DCD 0.212 and 0.208 against Mean's 0.227 and 0.151, results/console) and
+    /// meshes Poisson about as well (0.135 against 0.133, two seeds, results/poisson).
     #[arg(long, default_value = "amber-max")]
     pub method: Method,
     /// Training seed: selects the training problems and seeds the run.
