@@ -3,7 +3,9 @@
 //! error, backward, clipping, update) on a [`GraphBatch`] and its targets. It may also keep a
 //! moving average of the weights, the network it then hands to inference.
 
+use std::collections::HashMap;
 use std::path::Path;
+use std::sync::MutexGuard;
 
 use amber_graph::GraphBatch;
 use amber_nn::{Adam, Backend, Objective};
@@ -47,18 +49,21 @@ struct WeightAverage {
 
 impl WeightAverage {
     fn update(&self, weights: &VarMap, step: u64) -> candle_core::Result<()> {
-        let decay = self.decay.min((1 + step) as f64 / (10 + step) as f64);
-        let (weights, average) = (lock(weights)?, lock(&self.varmap)?);
-        for (name, var) in average.iter() {
-            let Some(w) = weights.get(name) else { candle_core::bail!("no trained weight `{name}`") };
-            var.set(&((var.as_tensor() * decay)? + (w.as_tensor() * (1.0 - decay))?)?)?;
-        }
-        Ok(())
+        blend(&self.varmap, weights, self.decay.min((1 + step) as f64 / (10 + step) as f64))
     }
 }
 
-fn lock(varmap: &VarMap) -> candle_core::Result<std::sync::MutexGuard<'_, std::collections::HashMap<String, Var>>> {
-    varmap.data().lock().map_err(|_| candle_core::Error::Msg("poisoned variable map".into()))
+/// `average ← decay·average + (1 − decay)·weights`, variable by variable (decay 0 copies).
+fn blend(average: &VarMap, weights: &VarMap, decay: f64) -> candle_core::Result<()> {
+    fn lock(varmap: &VarMap) -> candle_core::Result<MutexGuard<'_, HashMap<String, Var>>> {
+        varmap.data().lock().map_err(|_| candle_core::Error::Msg("poisoned variable map".into()))
+    }
+    let (average, weights) = (lock(average)?, lock(weights)?);
+    for (name, var) in average.iter() {
+        let Some(w) = weights.get(name) else { candle_core::bail!("no trained weight `{name}`") };
+        var.set(&((var.as_tensor() * decay)? + (w.as_tensor() * (1.0 - decay))?)?)?;
+    }
+    Ok(())
 }
 
 impl MpnTrainer {
@@ -105,13 +110,7 @@ impl MpnTrainer {
             }
             None => {
                 let (network, varmap) = Mpn::init(self.network.config().clone(), 0, DType::F32, &self.device)?;
-                let weights = lock(&self.varmap)?;
-                for (name, var) in lock(&varmap)?.iter() {
-                    let w = weights
-                        .get(name)
-                        .ok_or_else(|| candle_core::Error::Msg(format!("no trained weight `{name}`")))?;
-                    var.set(w.as_tensor())?;
-                }
+                blend(&varmap, &self.varmap, 0.0)?;
                 (network, varmap)
             }
         };

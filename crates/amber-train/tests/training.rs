@@ -10,7 +10,7 @@ use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::{INITIAL_SIZE, LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, PoissonProblem};
 use amber_train::{
     AmberModel, AmberSizing, DataConfig, Evaluation, MODEL_DIR, NetworkConfig, Predictor, ReplayBuffer, StepReport,
-    StepStatus, Training, TrainingConfig, TrainingObserver, rollouts,
+    StepStatus, Training, TrainingConfig, TrainingObserver, WEIGHTS_FILE, rollouts,
 };
 
 /// Problems with small experts (8 refinement steps: a few hundred triangles).
@@ -171,7 +171,7 @@ fn resumes_exactly(config: TrainingConfig) {
         assert!((la - lb).abs() <= 1e-6 * la.abs().max(1.0), "step {step}: {la} vs {lb}");
     }
     // The same model, byte for byte.
-    let weights = |run: &Path| std::fs::read(run.join(MODEL_DIR).join("model.safetensors")).unwrap();
+    let weights = |run: &Path| std::fs::read(run.join(MODEL_DIR).join(WEIGHTS_FILE)).unwrap();
     assert!(weights(&whole) == weights(&killed), "the resumed run's model differs");
     // Only the newest checkpoint is kept, and it names the final step.
     let latest = amber_train::latest_checkpoint(&killed).unwrap().unwrap();

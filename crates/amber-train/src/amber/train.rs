@@ -178,16 +178,11 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         }
         state.check(problems.len()).map_err(fail)?;
         // With a weight average the model's weights are the average, the trained ones beside.
-        let mut trainer = match config.weight_average_decay {
-            None => MpnTrainer::load(&dir.join(WEIGHTS_FILE), config.objective, config.max_grad_norm, config.device)?,
-            Some(decay) => MpnTrainer::load(
-                &dir.join(TRAINED_WEIGHTS_FILE),
-                config.objective,
-                config.max_grad_norm,
-                config.device,
-            )?
-            .with_weight_average(decay, Some(&dir.join(WEIGHTS_FILE)))?,
-        };
+        let trained = if config.weight_average_decay.is_some() { TRAINED_WEIGHTS_FILE } else { WEIGHTS_FILE };
+        let mut trainer = MpnTrainer::load(&dir.join(trained), config.objective, config.max_grad_norm, config.device)?;
+        if let Some(decay) = config.weight_average_decay {
+            trainer = trainer.with_weight_average(decay, Some(&dir.join(WEIGHTS_FILE)))?;
+        }
         let predictor = Predictor::read(&dir.join(super::model::PREDICTOR_FILE), trainer.network().config())?;
         trainer.load_optimiser(&dir.join(OPTIMISER_FILE), state.optimiser_steps)?;
         let load = |records: &[EntryRecord]| -> Result<Vec<_>> {
