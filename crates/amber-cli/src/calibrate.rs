@@ -1,5 +1,5 @@
 //! `amber calibrate`: a trained model re-fitted to the element counts of a folder of expert
-//! meshes (its final step scale, see `amber_train::fit_final_step_scale`), written as a new
+//! meshes (its final step scale, see `amber_train::fit_final_step`), written as a new
 //! model directory: where a team's experts mesh finer or coarser overall than the ones the model
 //! learned from, a handful of their meshes set the model's default element budget.
 

@@ -23,6 +23,7 @@ mod problem;
 
 pub use error::TaskError;
 pub use problem::{
-    Column, Domain, ELEMENT_COUNT_TOLERANCE, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError, RefineBox,
-    RefineFace, SizeBounds, StepOutcome, WithExpert, generation_step, labels, mesh_to_element_count, with_inputs,
+    Column, Domain, ELEMENT_COUNT_TOLERANCE, FinalCount, LOG_SIZE_COLUMN, MeshLimits, MeshState, Problem, ProblemError,
+    RefineBox, RefineFace, SizeBounds, StepOutcome, WithExpert, generation_step, labels, mesh_to_element_count,
+    with_inputs,
 };

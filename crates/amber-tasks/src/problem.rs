@@ -171,13 +171,56 @@ pub struct MeshLimits {
     pub scale_to_budget: bool,
     /// The last generation step's sizes are multiplied by this: fitted after training so that
     /// the model's meshes of its training parts have their experts' element counts (1: not
-    /// fitted). See `amber_train::fit_final_step_scale`.
+    /// fitted). See `amber_train::fit_final_step`.
     #[serde(default = "unit_scale")]
     pub final_step_scale: f64,
+    /// The last step's element count as a function of what the model's own (scaled) field asks
+    /// for, fitted after training as well (`None`: what the field asks for stands). See
+    /// [`FinalCount`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub final_count: Option<FinalCount>,
 }
 
 fn unit_scale() -> f64 {
     1.0
+}
+
+/// ln(count) = `expert_log_mean` + `slope` · (ln(estimate) − `model_log_mean`): the regression of
+/// the calibration experts' log element counts on the log of the count the model's last field
+/// asks for ([`estimated_element_count`], after the final step scale), over the calibration
+/// problems. Slope 1 leaves the model's count as it is; slope 0 gives every geometry the experts'
+/// typical count, which is what a model whose counts say nothing of its experts' should do (on
+/// Poisson, the model's final counts and the experts' are uncorrelated over test problems).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FinalCount {
+    /// In [0, 1].
+    pub slope: f64,
+    /// Mean of ln(estimate) over the calibration problems.
+    pub model_log_mean: f64,
+    /// Mean of ln(expert's element count) over the calibration problems.
+    pub expert_log_mean: f64,
+}
+
+impl FinalCount {
+    /// The element count for a field that asks for `estimate` elements.
+    pub fn target(&self, estimate: f64) -> usize {
+        (self.expert_log_mean + self.slope * (estimate.ln() - self.model_log_mean)).exp().round().max(1.0) as usize
+    }
+
+    /// The least-squares fit of `(ln estimate, ln expert count)` pairs, the slope clipped to
+    /// [0, 1] (0 when the estimates do not vary); `None` without pairs.
+    pub fn fit(pairs: &[(f64, f64)]) -> Option<Self> {
+        if pairs.is_empty() {
+            return None;
+        }
+        let n = pairs.len() as f64;
+        let model_log_mean = pairs.iter().map(|p| p.0).sum::<f64>() / n;
+        let expert_log_mean = pairs.iter().map(|p| p.1).sum::<f64>() / n;
+        let covariance = pairs.iter().map(|(m, e)| (m - model_log_mean) * (e - expert_log_mean)).sum::<f64>();
+        let variance = pairs.iter().map(|(m, _)| (m - model_log_mean).powi(2)).sum::<f64>();
+        let slope = if variance > 0.0 { (covariance / variance).clamp(0.0, 1.0) } else { 0.0 };
+        Some(Self { slope, model_log_mean, expert_log_mean })
+    }
 }
 
 impl MeshLimits {
@@ -200,6 +243,7 @@ impl MeshLimits {
             max_elements: (budget_factor * largest as f64) as usize,
             scale_to_budget: false,
             final_step_scale: 1.0,
+            final_count: None,
         }
     }
 
@@ -674,6 +718,28 @@ mod tests {
         assert!(bad(0.001).contains("below the minimum size"));
     }
 
+    /// The fit recovers an exact power law, clips a slope beyond [0, 1], and maps the mean
+    /// estimate to the experts' geometric mean count whatever the slope.
+    #[test]
+    fn the_final_count_regresses_log_counts() {
+        let line = |slope: f64| -> Vec<(f64, f64)> {
+            [1_000.0f64, 2_000.0, 8_000.0].iter().map(|m| (m.ln(), 5.0 + slope * m.ln())).collect()
+        };
+        let half = FinalCount::fit(&line(0.5)).unwrap();
+        assert!((half.slope - 0.5).abs() < 1e-12, "{half:?}");
+        assert_eq!(FinalCount::fit(&line(1.7)).unwrap().slope, 1.0);
+        assert_eq!(FinalCount::fit(&line(-0.3)).unwrap().slope, 0.0);
+        let flat = FinalCount::fit(&[(7.0, 9.0), (7.0, 10.0)]).unwrap();
+        assert_eq!(
+            (flat.slope, flat.target(1.0), flat.target(1e6)),
+            (0.0, 9.5f64.exp().round() as usize, 9.5f64.exp().round() as usize)
+        );
+        assert!(FinalCount::fit(&[]).is_none());
+        let mean_estimate = half.model_log_mean.exp();
+        assert_eq!(half.target(mean_estimate), half.expert_log_mean.exp().round() as usize);
+        assert_eq!(half.target(4.0 * mean_estimate), (2.0 * half.expert_log_mean.exp()).round() as usize);
+    }
+
     /// A field over the model's budget is scaled to it before a refinement box acts: the box's
     /// elements keep within its size, and only the model's field pays for the budget.
     #[test]
@@ -681,7 +747,13 @@ mod tests {
         let domain = PolygonDomain::new(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], vec![]).unwrap();
         let square = PlanarPart::new("square".into(), domain, 0.1).unwrap();
         let mesh = square.initial_mesh();
-        let limits = MeshLimits { min_size: 1e-3, max_elements: 500, scale_to_budget: true, final_step_scale: 1.0 };
+        let limits = MeshLimits {
+            min_size: 1e-3,
+            max_elements: 500,
+            scale_to_budget: true,
+            final_step_scale: 1.0,
+            final_count: None,
+        };
         let refine = RefineBox { lo: vec![0.0, 0.0], hi: vec![0.2, 0.2], max_size: 0.012 };
         let bounds = SizeBounds::default().with_box(refine).unwrap();
         // An estimate of 924 elements, about twice the budget, before the box adds about 900.

@@ -46,6 +46,6 @@ pub use error::{Result, TrainError};
 pub use method::{MethodConfig, TrainedModel};
 pub use observer::{StepReport, TrainingObserver};
 pub use rollout::{
-    Evaluation, EvaluationSummary, FinalStep, GeneratedStep, MeshMetrics, PredictedField, Reference, Rollout,
-    RolloutStep, SizingModel, StepStatus, StepSummary, fit_final_step_scale, generate, rollouts,
+    Evaluation, EvaluationSummary, FinalStep, FinalStepFit, GeneratedStep, MeshMetrics, PredictedField, Reference,
+    Rollout, RolloutStep, SizingModel, StepStatus, StepSummary, fit_final_step, generate, rollouts,
 };

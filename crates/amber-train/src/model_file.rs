@@ -34,6 +34,11 @@ pub(crate) fn check_limits(limits: &MeshLimits) -> Result<(), String> {
     if !(limits.final_step_scale.is_finite() && limits.final_step_scale > 0.0) {
         return Err(format!("limits.final_step_scale is {}, not a positive factor", limits.final_step_scale));
     }
+    if let Some(count) = limits.final_count
+        && !(0.0..=1.0).contains(&count.slope)
+    {
+        return Err(format!("limits.final_count.slope is {}, not within [0, 1]", count.slope));
+    }
     Ok(())
 }
 
@@ -64,8 +69,13 @@ mod tests {
         TargetTransform, WEIGHTS_FILE,
     };
 
-    const LIMITS: MeshLimits =
-        MeshLimits { min_size: 0.01, max_elements: 1_000, scale_to_budget: false, final_step_scale: 1.0 };
+    const LIMITS: MeshLimits = MeshLimits {
+        min_size: 0.01,
+        max_elements: 1_000,
+        scale_to_budget: false,
+        final_step_scale: 1.0,
+        final_count: None,
+    };
 
     /// An untrained AMBER model (the console features: one node and two edge columns).
     fn amber_model(dir: &Path) {
@@ -158,6 +168,9 @@ mod tests {
         json("/limits/min_size", json!(-0.5), "limits.min_size is -0.5");
         json("/limits/max_elements", json!(0), "limits.max_elements is 0");
         json("/limits/final_step_scale", json!(-2.0), "limits.final_step_scale is -2");
+        let count = json!({"slope": 1.5, "model_log_mean": 7.0, "expert_log_mean": 7.0});
+        let limits = json!({"min_size": 0.01, "max_elements": 1_000, "final_count": count});
+        json("/limits", limits, "limits.final_count.slope is 1.5");
         // The fuzz input fuzz/corpus/model_dir/crash-predictor-fewer-features-than-network: without
         // a normaliser, a feature list cut short loaded and failed only in the first prediction,
         // with a message naming no file.

@@ -11,8 +11,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError, in_problem};
+use amber_meshgen::estimated_element_count;
 use amber_tasks::{
-    Domain, MeshLimits, Problem, ProblemError, SizeBounds, StepOutcome, generation_step, mesh_to_element_count,
+    Domain, FinalCount, MeshLimits, Problem, ProblemError, SizeBounds, StepOutcome, generation_step,
+    mesh_to_element_count,
 };
 
 /// The per-problem constants of the normalised DCD: the reconstruction M̂ (the generator run
@@ -194,7 +196,12 @@ pub fn rollouts<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
                 };
                 let Some(field) = field else { return Ok(carried(StepStatus::Stopped)) };
                 let on = field.mesh.as_ref().unwrap_or(previous);
-                Ok(match generation_step(problem, on, field.sizes, model.limits(), &SizeBounds::default()) {
+                let limits = model.limits();
+                let outcome = match final_count_target(limits, on, &field.sizes).filter(|_| step == steps) {
+                    Some(target) => mesh_to_final_count(problem, on, &field.sizes, limits, target),
+                    None => generation_step(problem, on, field.sizes, limits, &SizeBounds::default()),
+                };
+                Ok(match outcome {
                     StepOutcome::Meshed(mesh) => {
                         let metrics =
                             MeshMetrics::of(&mesh, problem.expert_mesh(), &references[i]).map_err(in_problem(i))?;
@@ -255,7 +262,8 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
             field.scale(model.limits().final_step_scale);
         }
         let on = field.mesh.as_ref().unwrap_or(current);
-        let mesh = match last.elements.filter(|_| step == steps) {
+        let elements = last.elements.or_else(|| final_count_target(model.limits(), on, &field.sizes));
+        let mesh = match elements.filter(|_| step == steps) {
             Some(elements) => {
                 let min_size = model.limits().min_size;
                 let sizes: Vec<f64> = field.sizes.iter().map(|h| h.max(min_size)).collect();
@@ -285,28 +293,62 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     Ok(out)
 }
 
-/// Meshings of the last step [`fit_final_step_scale`] spends per problem at most.
+/// The element count of the last step of a model whose limits hold a [`FinalCount`]: the one
+/// fitted to what its (scaled, clipped) field on `mesh` asks for, within the budget.
+fn final_count_target<const D: usize>(limits: &MeshLimits, mesh: &Mesh<D>, sizes: &[f64]) -> Option<usize> {
+    let count = limits.final_count?;
+    let clipped: Vec<f64> = sizes.iter().map(|h| h.max(limits.min_size)).collect();
+    Some(count.target(estimated_element_count(mesh, &clipped)).min(limits.max_elements))
+}
+
+/// The last step of a rollout with a [`FinalCount`]: the field, clipped at h_min, keeps its shape
+/// and is scaled to `target` elements.
+fn mesh_to_final_count<const D: usize, P: Problem<D>>(
+    problem: &P,
+    mesh: &Mesh<D>,
+    sizes: &[f64],
+    limits: &MeshLimits,
+    target: usize,
+) -> StepOutcome<D> {
+    let sizes: Vec<f64> = sizes.iter().map(|h| h.max(limits.min_size)).collect();
+    match mesh_to_element_count(problem, mesh, &sizes, target, &SizeBounds::default(), limits.generator_cap()) {
+        Ok(mesh) => StepOutcome::Meshed(mesh),
+        Err(e) => StepOutcome::Failed { reason: e.to_string() },
+    }
+}
+
+/// Meshings of the last step [`fit_final_step`] spends per problem at most.
 const CALIBRATION_ROUNDS: usize = 3;
 
 /// A fitted scale within this factor of the previous round's is final.
 const CALIBRATION_TOLERANCE: f64 = 1.01;
 
+/// What [`fit_final_step`] fits from the same last fields: the final step scale and the count
+/// regression after it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FinalStepFit {
+    pub scale: f64,
+    pub count: FinalCount,
+}
+
 /// The factor on the last step's sizes that gives `model`'s meshes of `problems` after `steps`
 /// steps their experts' element counts, in the geometric mean over problems: the element budget
 /// the experts chose, learned from them. A model that learned where to refine but not how much
 /// overall (residual steps that converge short of the expert's level) is corrected by one
-/// number. `model` must have a `final_step_scale` of 1. The first `steps - 1` steps are
-/// generated once; the last is meshed with the current factor, which each round corrects by
-/// the mean ratio of counts to the power 1/D, until it moves by less than
+/// number. `model` must have a `final_step_scale` of 1 and no `final_count`. The first
+/// `steps - 1` steps are generated once; the last is meshed with the current factor, which each
+/// round corrects by the mean ratio of counts to the power 1/D, until it moves by less than
 /// [`CALIBRATION_TOLERANCE`] or [`CALIBRATION_ROUNDS`] meshings are spent. A problem whose
-/// rollout or last meshing fails is left out of the mean.
-pub fn fit_final_step_scale<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
+/// rollout or last meshing fails is left out of the mean. The same last fields, scaled, then fit
+/// the [`FinalCount`] regression (no meshing: it regresses on the fields' estimated counts).
+pub fn fit_final_step<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
     model: &M,
     problems: &[P],
     steps: usize,
-) -> Result<f64> {
-    if model.limits().final_step_scale != 1.0 {
-        return Err(TrainError::InvalidConfig("fitting a final step scale needs an unscaled model".into()));
+) -> Result<FinalStepFit> {
+    let limits = model.limits();
+    if limits.final_step_scale != 1.0 || limits.final_count.is_some() {
+        return Err(TrainError::InvalidConfig("fitting the final step needs a model without a fitted one".into()));
     }
     let last_fields: Vec<(&P, Mesh<D>, PredictedField<D>)> = problems
         .par_iter()
@@ -317,15 +359,16 @@ pub fn fit_final_step_scale<const D: usize, P: Problem<D>, M: SizingModel + ?Siz
             Some((p, mesh, field))
         })
         .collect();
-    let limits = model.limits();
+    let scaled = |field: &PredictedField<D>, scale: f64| -> Vec<f64> {
+        field.sizes.iter().map(|h| (h * scale).max(limits.min_size)).collect()
+    };
     let mut scale = 1.0;
     for _ in 0..CALIBRATION_ROUNDS {
         let log_ratios: Vec<f64> = last_fields
             .par_iter()
             .filter_map(|(problem, mesh, field)| {
-                let sizes = field.sizes.iter().map(|h| (h * scale).max(limits.min_size)).collect();
                 let on = field.mesh.as_ref().unwrap_or(mesh);
-                let made = problem.remesh(on, sizes, limits.generator_cap()).ok()?;
+                let made = problem.remesh(on, scaled(field, scale), limits.generator_cap()).ok()?;
                 Some((made.num_elements() as f64 / problem.expert_mesh().num_elements() as f64).ln())
             })
             .collect();
@@ -339,7 +382,19 @@ pub fn fit_final_step_scale<const D: usize, P: Problem<D>, M: SizingModel + ?Siz
             break;
         }
     }
-    Ok(scale)
+    let log_counts: Vec<(f64, f64)> = last_fields
+        .iter()
+        .map(|(problem, mesh, field)| {
+            let estimate = estimated_element_count(field.mesh.as_ref().unwrap_or(mesh), &scaled(field, scale));
+            (estimate.ln(), (problem.expert_mesh().num_elements() as f64).ln())
+        })
+        .filter(|(model, _)| model.is_finite())
+        .collect();
+    let count = FinalCount::fit(&log_counts).ok_or_else(|| {
+        let reason = "no problem's last field asks for a finite element count".into();
+        TrainError::Generation { step: steps, reason }
+    })?;
+    Ok(FinalStepFit { scale, count })
 }
 
 /// Means over problems at one generation step.
@@ -459,32 +514,75 @@ mod tests {
         }
     }
 
-    /// A model that asks for twice the experts' size (a quarter of their elements) is scaled by
-    /// about one half, and its meshes then have the experts' counts; the last step alone is.
-    #[test]
-    fn the_final_step_scale_gives_the_experts_element_counts() {
+    /// Squares of the given sides, each with an expert mesh of the paired uniform size.
+    fn squares(experts: &[(f64, f64)]) -> Vec<WithExpert<PlanarPart, 2>> {
         let square = |side: f64| vec![[0.0, 0.0], [side, 0.0], [side, side], [0.0, side]];
-        let problems: Vec<WithExpert<PlanarPart, 2>> = [1.0, 1.5]
-            .into_iter()
-            .map(|side| {
+        experts
+            .iter()
+            .map(|&(side, size)| {
                 let domain = PlanarPart::new("square".into(), PolygonDomain::new(square(side), vec![]).unwrap(), 0.2);
                 let domain = domain.unwrap();
                 let mesh = domain.initial_mesh().clone();
-                let expert_mesh = domain.remesh(&mesh, vec![0.04; mesh.num_elements()], 1_000_000).unwrap();
+                let expert_mesh = domain.remesh(&mesh, vec![size; mesh.num_elements()], 1_000_000).unwrap();
                 WithExpert::new(domain, expert_mesh, std::path::Path::new("square.json")).unwrap()
             })
-            .collect();
-        let limits =
-            MeshLimits { min_size: 1e-3, max_elements: 1_000_000, scale_to_budget: false, final_step_scale: 1.0 };
-        let mut model = Uniform { size: 0.08, limits };
-        let scale = fit_final_step_scale(&model, &problems, 2).unwrap();
-        assert!((0.45..0.55).contains(&scale), "scale {scale}");
+            .collect()
+    }
+
+    const UNSCALED: MeshLimits = MeshLimits {
+        min_size: 1e-3,
+        max_elements: 1_000_000,
+        scale_to_budget: false,
+        final_step_scale: 1.0,
+        final_count: None,
+    };
+
+    /// A model that asks for twice the experts' size (a quarter of their elements) is scaled by
+    /// about one half, and its meshes then have the experts' counts; the last step alone is. Its
+    /// counts follow the experts' (both go as the area), so the count regression keeps them.
+    #[test]
+    fn the_final_step_scale_gives_the_experts_element_counts() {
+        let problems = squares(&[(1.0, 0.04), (1.5, 0.04)]);
+        let mut model = Uniform { size: 0.08, limits: UNSCALED };
+        let fit = fit_final_step(&model, &problems, 2).unwrap();
+        assert!((0.45..0.55).contains(&fit.scale), "scale {}", fit.scale);
+        assert!(fit.count.slope > 0.9, "{:?}", fit.count);
         let unscaled = generate(&model, &problems[1], 2, FinalStep::default()).unwrap();
-        model.limits.final_step_scale = scale;
-        assert!(fit_final_step_scale(&model, &problems, 2).is_err(), "a scaled model is refitted from 1");
+        model.limits.final_step_scale = fit.scale;
+        assert!(fit_final_step(&model, &problems, 2).is_err(), "a scaled model is refitted from 1");
         let scaled = generate(&model, &problems[1], 2, FinalStep::default()).unwrap();
         assert_eq!(scaled[0].mesh.num_elements(), unscaled[0].mesh.num_elements());
         let (made, expert) = (scaled[1].mesh.num_elements() as f64, problems[1].expert_mesh.num_elements() as f64);
         assert!((made / expert - 1.0).abs() < 0.05, "{made} elements for the expert's {expert}");
+    }
+
+    /// Experts that mesh a square and one of 2.25 times its area with the same number of
+    /// elements, and a model whose count goes as the area: the regression's slope is 0, and
+    /// with it both the evaluation's rollouts and `generate` end at the experts' count, where
+    /// the scale alone misses both squares by half.
+    #[test]
+    fn the_count_regression_gives_a_count_the_model_misses() {
+        let problems = squares(&[(1.0, 0.04), (1.5, 0.06)]);
+        let references = Reference::for_problems(&problems, &UNSCALED).unwrap();
+        let mut model = Uniform { size: 0.08, limits: UNSCALED };
+        let fit = fit_final_step(&model, &problems, 2).unwrap();
+        assert_eq!(fit.count.slope, 0.0, "{:?}", fit.count);
+        let final_counts = |model: &Uniform| -> Vec<f64> {
+            let rolled = rollouts(model, &problems, &references, 2).unwrap();
+            problems
+                .iter()
+                .zip(&rolled)
+                .map(|(p, r)| r.steps[1].metrics.elements as f64 / p.expert_mesh.num_elements() as f64)
+                .collect()
+        };
+        model.limits.final_step_scale = fit.scale;
+        let scaled = final_counts(&model);
+        assert!(scaled[0] < 0.8 && scaled[1] > 1.2, "the scale alone: {scaled:?} of the experts' counts");
+        model.limits.final_count = Some(fit.count);
+        let regressed = final_counts(&model);
+        assert!(regressed.iter().all(|r| (r - 1.0).abs() < 0.1), "{regressed:?} of the experts' counts");
+        let generated = generate(&model, &problems[1], 2, FinalStep::default()).unwrap();
+        let made = generated[1].mesh.num_elements() as f64 / problems[1].expert_mesh.num_elements() as f64;
+        assert!((made - 1.0).abs() < 0.1, "generate: {made} of the expert's count");
     }
 }

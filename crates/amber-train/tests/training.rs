@@ -246,8 +246,13 @@ fn rollouts_return_every_mesh_with_finite_metrics() {
 fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
     let problem = problems(&[3]).remove(0);
     let m0 = amber_tasks::Domain::initial_mesh(&problem).clone();
-    let mut limits =
-        amber_tasks::MeshLimits { min_size: 1e-6, max_elements: 2_000, scale_to_budget: false, final_step_scale: 1.0 };
+    let mut limits = amber_tasks::MeshLimits {
+        min_size: 1e-6,
+        max_elements: 2_000,
+        scale_to_budget: false,
+        final_step_scale: 1.0,
+        final_count: None,
+    };
     // 0.005 everywhere asks for ~70k triangles on the L-shape.
     let fine = vec![0.005; m0.num_elements()];
     let outcome =

@@ -84,9 +84,15 @@ pub struct TrainingConfig {
     /// Generation steps T of a rollout (validation and inference).
     pub inference_steps: usize,
     /// After training, fit the model's final step scale to the training experts' element counts
-    /// (`fit_final_step_scale`); off in the paper.
+    /// (`fit_final_step`); off in the paper.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub calibrate_element_count: bool,
+    /// With `calibrate_element_count`, also fit the last step's element count as a regression of
+    /// the training experts' log counts on the model's (`amber_tasks::FinalCount`): a model whose
+    /// counts do not follow its experts' then meshes every geometry to their typical count.
+    /// Omitted from the JSON when off.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub count_regression: bool,
     /// Write a checkpoint every this many steps (and at the end).
     pub checkpoint_interval: u64,
     /// Roll out the validation problems every this many steps (and at the end); 0: never.
@@ -143,6 +149,7 @@ impl TrainingConfig {
             min_size_quantile: 0.0,
             inference_steps: 5,
             calibrate_element_count: false,
+            count_regression: false,
             checkpoint_interval: 2_560,
             validation_interval: 2_560,
             device: Backend::Cpu,
@@ -228,6 +235,9 @@ impl TrainingConfig {
         if self.max_grad_norm.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
             return bad("max_grad_norm must be positive");
         }
+        if self.count_regression && !self.calibrate_element_count {
+            return bad("count_regression needs calibrate_element_count");
+        }
         if self.weight_average_decay.is_some_and(|d| !(0.0..1.0).contains(&d)) {
             return bad("weight_average_decay must be in [0, 1)");
         }
@@ -300,6 +310,9 @@ mod tests {
         // The device joined the config after runs were cached under its JSON: the CPU is not
         // written, so their keys stay.
         assert!(!serde_json::to_string(&TrainingConfig::quick()).unwrap().contains("device"));
+        assert!(!serde_json::to_string(&TrainingConfig::quick()).unwrap().contains("count_regression"));
+        let uncalibrated = TrainingConfig { count_regression: true, ..TrainingConfig::paper() };
+        assert!(uncalibrated.validate().unwrap_err().to_string().contains("needs calibrate_element_count"));
         let gpu: TrainingConfig = serde_json::from_str(r#"{"device": {"cuda": 0}}"#).unwrap();
         assert_eq!(gpu.device, Backend::Cuda(0));
         let bad =

@@ -27,7 +27,7 @@ use crate::checkpoint::{
 use crate::error::{Result, TrainError, in_problem, io_error};
 use crate::{
     AmberModel, AmberSizing, Evaluation, EvaluationSummary, Predictor, ReplayBuffer, Sample, StepReport,
-    TargetTransform, TrainingConfig, TrainingObserver, fit_final_step_scale,
+    TargetTransform, TrainingConfig, TrainingObserver, fit_final_step,
 };
 
 /// The final model's sub-directory of the output directory.
@@ -385,8 +385,9 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         }
         if self.config.calibrate_element_count {
             let sizing = AmberSizing { network: self.network(), predictor: &self.predictor };
-            let scale = fit_final_step_scale(&sizing, &self.problems, self.config.inference_steps)?;
-            self.predictor.limits.final_step_scale = scale;
+            let fit = fit_final_step(&sizing, &self.problems, self.config.inference_steps)?;
+            self.predictor.limits.final_step_scale = fit.scale;
+            self.predictor.limits.final_count = self.config.count_regression.then_some(fit.count);
         }
         self.save_model(&out_dir.join(MODEL_DIR))
     }
