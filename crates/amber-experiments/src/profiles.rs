@@ -66,6 +66,9 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
                 // The final step scale: a seed whose meshes stop at 0.7 of the experts' count
                 // 0.18 → 0.15 on hard, the other seed unchanged; not in the paper.
                 config.calibrate_element_count = true;
+                // The network's final counts do not follow the experts' here (docs/PROFILES.md),
+                // so the last step is meshed to the count regressed on theirs; not in the paper.
+                config.count_regression = true;
             }
         }
         Task::Console | Task::Folder { .. } => {
@@ -162,6 +165,8 @@ mod tests {
         assert!(amber_config(Task::Console, Profile::Quick).inputs.iter().all(|i| i != LOG_ERROR_INDICATOR_COLUMN));
         assert!(amber_config(Task::Poisson, Profile::Paper).inputs.is_empty());
         assert!(amber_config(Task::Poisson, Profile::Quick).calibrate_element_count);
+        assert!(amber_config(Task::Poisson, Profile::Quick).count_regression);
+        assert!(!amber_config(Task::Console, Profile::Quick).count_regression);
         assert!(!amber_config(Task::Poisson, Profile::Paper).calibrate_element_count);
         for profile in Profile::ALL {
             let inputs = amber_config(Task::Folder { dimension: 3 }, profile).inputs;
