@@ -31,8 +31,8 @@ pub struct TrainingArgs {
     profile: Profile,
     /// amber-mean or amber-max: how the expert's sizes become labels on a coarser mesh. Max,
     /// the default, varies less between training seeds on Console's validation parts
-    /// (normalised DCD 0.212 and 0.208 against Mean's 0.227 and 0.151, results/console) and
-    /// meshes Poisson about as well (0.135 against 0.133, two seeds, results/poisson).
+    /// (normalised DCD 0.200 and 0.197 against Mean's 0.224 and 0.154, results/console) and
+    /// meshes Poisson as well (0.090 against 0.089, two seeds, results/poisson).
     #[arg(long, default_value = "amber-max")]
     pub method: Method,
     /// Training seed: selects the training problems and seeds the run.

@@ -75,6 +75,9 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
             // Spec §9: h_min at the 0.5 % quantile of the training experts' sizes.
             config.min_size_quantile = 0.005;
             config.calibrate_element_count = true;
+            // Fitted on the training parts: a slope near 1 where the model's counts follow the
+            // experts' (Console's do), near 0 where they do not; not in the paper.
+            config.count_regression = true;
             // Geometry is all a folder offers; log h(K) is the generic input every profile but
             // the paper's already reads (the paper's Console network goes without it).
             if task != Task::Console && !config.inputs.iter().any(|i| i == LOG_SIZE_COLUMN) {
@@ -166,7 +169,7 @@ mod tests {
         assert!(amber_config(Task::Poisson, Profile::Paper).inputs.is_empty());
         assert!(amber_config(Task::Poisson, Profile::Quick).calibrate_element_count);
         assert!(amber_config(Task::Poisson, Profile::Quick).count_regression);
-        assert!(!amber_config(Task::Console, Profile::Quick).count_regression);
+        assert!(amber_config(Task::Console, Profile::Quick).count_regression);
         assert!(!amber_config(Task::Poisson, Profile::Paper).calibrate_element_count);
         for profile in Profile::ALL {
             let inputs = amber_config(Task::Folder { dimension: 3 }, profile).inputs;
