@@ -98,12 +98,13 @@ impl PoissonExperiment {
     pub fn ablation(profile: Profile) -> Self {
         let mut experiment = Self::new(profile);
         // The ablations vary the paper's choices on the paper's network, inputs and rollouts:
-        // without the graph context, the error-indicator feature and the final step scale of the
-        // quick profile.
+        // without the graph context, the error-indicator feature, the final step scale and the
+        // count regression of the quick profile.
         experiment.overrides = serde_json::json!({
             "network": { "graph_context": false },
             "inputs": [LOG_SIZE_COLUMN],
             "calibrate_element_count": false,
+            "count_regression": false,
         });
         if profile == Profile::Quick {
             // Seventeen runs in three hours on two cores: each AMBER run gets 600 of the

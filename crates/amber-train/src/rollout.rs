@@ -197,7 +197,7 @@ pub fn rollouts<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
                 let Some(field) = field else { return Ok(carried(StepStatus::Stopped)) };
                 let on = field.mesh.as_ref().unwrap_or(previous);
                 let limits = model.limits();
-                let outcome = match final_count_target(limits, on, &field.sizes).filter(|_| step == steps) {
+                let outcome = match (step == steps).then(|| final_count_target(limits, on, &field.sizes)).flatten() {
                     Some(target) => mesh_to_final_count(problem, on, &field.sizes, limits, target),
                     None => generation_step(problem, on, field.sizes, limits, &SizeBounds::default()),
                 };
@@ -243,8 +243,9 @@ pub struct FinalStep {
 /// h_min, budget guard, mesh), as a rollout does but without an expert to compare with. The
 /// last step does what `last` asks: with a target, its field keeps its shape and is scaled to
 /// the target's element count (instead of the budget guard): the model decides where elements
-/// go, the user how many; without one, by the model's `final_step_scale`; either way its sizes
-/// are then held within `last.bounds` (after the model's budget guard, see [`generation_step`]).
+/// go, the user how many; without one, by the model's `final_step_scale`, and meshed to the
+/// count its [`FinalCount`] gives if it has one; either way its sizes are then held within
+/// `last.bounds` (after the model's budget guard, see [`generation_step`]).
 /// A step that makes no mesh is an error naming the step.
 pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     model: &M,
@@ -262,8 +263,9 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
             field.scale(model.limits().final_step_scale);
         }
         let on = field.mesh.as_ref().unwrap_or(current);
-        let elements = last.elements.or_else(|| final_count_target(model.limits(), on, &field.sizes));
-        let mesh = match elements.filter(|_| step == steps) {
+        let elements =
+            (step == steps).then(|| last.elements.or_else(|| final_count_target(model.limits(), on, &field.sizes)));
+        let mesh = match elements.flatten() {
             Some(elements) => {
                 let min_size = model.limits().min_size;
                 let sizes: Vec<f64> = field.sizes.iter().map(|h| h.max(min_size)).collect();
