@@ -197,8 +197,15 @@ pub fn rollouts<const D: usize, P: Problem<D>, M: SizingModel + ?Sized>(
                 let Some(field) = field else { return Ok(carried(StepStatus::Stopped)) };
                 let on = field.mesh.as_ref().unwrap_or(previous);
                 let limits = model.limits();
-                let outcome = match (step == steps).then(|| final_count_target(limits, on, &field.sizes)).flatten() {
-                    Some(target) => mesh_to_final_count(problem, on, &field.sizes, limits, target),
+                let counted = (step == steps).then(|| last_step_count(limits, on, &field.sizes, None)).flatten();
+                let outcome = match counted {
+                    Some((sizes, target)) => {
+                        let unbounded = &SizeBounds::default();
+                        match mesh_to_element_count(problem, on, &sizes, target, unbounded, limits.generator_cap()) {
+                            Ok(mesh) => StepOutcome::Meshed(mesh),
+                            Err(e) => StepOutcome::Failed { reason: e.to_string() },
+                        }
+                    }
                     None => generation_step(problem, on, field.sizes, limits, &SizeBounds::default()),
                 };
                 Ok(match outcome {
@@ -263,12 +270,9 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
             field.scale(model.limits().final_step_scale);
         }
         let on = field.mesh.as_ref().unwrap_or(current);
-        let elements =
-            (step == steps).then(|| last.elements.or_else(|| final_count_target(model.limits(), on, &field.sizes)));
-        let mesh = match elements.flatten() {
-            Some(elements) => {
-                let min_size = model.limits().min_size;
-                let sizes: Vec<f64> = field.sizes.iter().map(|h| h.max(min_size)).collect();
+        let counted = (step == steps).then(|| last_step_count(model.limits(), on, &field.sizes, last.elements));
+        let mesh = match counted.flatten() {
+            Some((sizes, elements)) => {
                 let cap = last.bounds.element_cap(model.limits());
                 mesh_to_element_count(domain, on, &sizes, elements, &last.bounds, cap).map_err(|e| match e {
                     ProblemError::Meshing(MeshgenError::TooManyElements { cap }) => TrainError::OverCap { step, cap },
@@ -295,27 +299,24 @@ pub fn generate<const D: usize, P: Domain<D>, M: SizingModel + ?Sized>(
     Ok(out)
 }
 
-/// The element count of the last step of a model whose limits hold a [`FinalCount`]: the one
-/// fitted to what its (scaled, clipped) field on `mesh` asks for, within the budget.
-fn final_count_target<const D: usize>(limits: &MeshLimits, mesh: &Mesh<D>, sizes: &[f64]) -> Option<usize> {
-    let count = limits.final_count?;
-    let clipped: Vec<f64> = sizes.iter().map(|h| h.max(limits.min_size)).collect();
-    Some(count.target(estimated_element_count(mesh, &clipped)).min(limits.max_elements))
-}
-
-/// The last step of a rollout with a [`FinalCount`]: the field, clipped at h_min, keeps its shape
-/// and is scaled to `target` elements.
-fn mesh_to_final_count<const D: usize, P: Problem<D>>(
-    problem: &P,
+/// The last step's field clipped at h_min, with the element count it is meshed to: `asked` (the
+/// user's) if given, else the count the model's [`FinalCount`] fits to what the clipped field asks
+/// for, within the budget. `None` when neither gives a count: the budget guard decides then.
+fn last_step_count<const D: usize>(
+    limits: &MeshLimits,
     mesh: &Mesh<D>,
     sizes: &[f64],
-    limits: &MeshLimits,
-    target: usize,
-) -> StepOutcome<D> {
-    let sizes: Vec<f64> = sizes.iter().map(|h| h.max(limits.min_size)).collect();
-    match mesh_to_element_count(problem, mesh, &sizes, target, &SizeBounds::default(), limits.generator_cap()) {
-        Ok(mesh) => StepOutcome::Meshed(mesh),
-        Err(e) => StepOutcome::Failed { reason: e.to_string() },
+    asked: Option<usize>,
+) -> Option<(Vec<f64>, usize)> {
+    let clip = || sizes.iter().map(|h| h.max(limits.min_size)).collect::<Vec<f64>>();
+    match (asked, limits.final_count) {
+        (Some(elements), _) => Some((clip(), elements)),
+        (None, Some(count)) => {
+            let clipped = clip();
+            let elements = count.target(estimated_element_count(mesh, &clipped)).min(limits.max_elements);
+            Some((clipped, elements))
+        }
+        (None, None) => None,
     }
 }
 
