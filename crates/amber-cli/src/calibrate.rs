@@ -1,14 +1,15 @@
 //! `amber calibrate`: a trained model re-fitted to the element counts of a folder of expert
-//! meshes (its final step scale, see `amber_train::fit_final_step`), written as a new
-//! model directory: where a team's experts mesh finer or coarser overall than the ones the model
-//! learned from, a handful of their meshes set the model's default element budget.
+//! meshes (its final step scale and count regression, see `amber_train::fit_final_step`),
+//! written as a new model directory: where a team's experts mesh finer or coarser overall than
+//! the ones the model learned from, a handful of their meshes set the model's default element
+//! budget.
 
 use std::path::{Path, PathBuf};
 
 use amber_experiments::{ModelCard, Task};
 use amber_tasks::folder::{DatasetSettings, FolderDomain, Split, problems, read_experts};
 use amber_tasks::part::{PlanarPart, SolidPart};
-use amber_train::TrainedModel;
+use amber_train::{FinalStepFit, TrainedModel};
 use anyhow::{Context, bail};
 use clap::Args;
 
@@ -25,6 +26,10 @@ pub struct CalibrateArgs {
     /// The new model directory (the model's files with the fitted predictor).
     #[arg(long, short)]
     out: PathBuf,
+    /// Also fit the count regression (the last step meshed to the count the experts' log counts
+    /// regress to) for a model trained without one; a model with one always refits it.
+    #[arg(long)]
+    count_regression: bool,
 }
 
 pub fn run(args: CalibrateArgs) -> anyhow::Result<()> {
@@ -35,34 +40,43 @@ pub fn run(args: CalibrateArgs) -> anyhow::Result<()> {
     let LoadedModel { dir, card, mut model, steps } = loaded;
     let settings = DatasetSettings::read(split.parent().unwrap_or(Path::new(".")))?;
     let before = model.limits().final_step_scale;
-    let scale = match card.task {
+    let count_regression = args.count_regression;
+    let fit = match card.task {
         Task::Console | Task::Folder { dimension: 3 } => {
-            fit::<3, SolidPart>(&mut model, &split, &card, &settings, steps)?
+            fit::<3, SolidPart>(&mut model, &split, &card, &settings, steps, count_regression)?
         }
-        Task::Folder { dimension: 2 } => fit::<2, PlanarPart>(&mut model, &split, &card, &settings, steps)?,
+        Task::Folder { dimension: 2 } => {
+            fit::<2, PlanarPart>(&mut model, &split, &card, &settings, steps, count_regression)?
+        }
         Task::Poisson => bail!("{}: a Poisson model is calibrated on Poisson problems, not meshes", dir.display()),
         Task::Folder { dimension } => bail!("{}: a model of {dimension}D meshes", dir.display()),
     };
     copy_model(&dir, &args.out)?;
     model.write_predictor(&args.out)?;
+    let count = match model.limits().final_count {
+        Some(count) => format!("; count regression slope {:.3}", count.slope),
+        None => String::new(),
+    };
     println!(
-        "final step scale {scale:.4} (was {before:.4}), fitted on {} after {steps} steps; wrote {}",
+        "final step scale {:.4} (was {before:.4}){count}, fitted on {} after {steps} steps; wrote {}",
+        fit.scale,
         split.display(),
         args.out.display()
     );
     Ok(())
 }
 
-/// Loads the experts of `split` as parts with the card's M⁰ and fits the model's scale on them.
+/// Loads the experts of `split` as parts with the card's M⁰ and fits the model's last step on them.
 fn fit<const D: usize, P: FolderDomain<D>>(
     model: &mut TrainedModel,
     split: &Path,
     card: &ModelCard,
     settings: &DatasetSettings,
     steps: usize,
-) -> anyhow::Result<f64> {
+    count_regression: bool,
+) -> anyhow::Result<FinalStepFit> {
     let parts = problems::<D, P>(read_experts::<D>(split, None)?, card.initial_size, settings)?;
-    Ok(model.calibrate(&parts, steps)?)
+    Ok(model.calibrate(&parts, steps, count_regression)?)
 }
 
 /// Copies the files of the model directory `from` (weights, predictor, card) into `to`.

@@ -535,17 +535,32 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
 
     // Calibrated on the test plates, the model meshes them with their experts' counts (in the
     // geometric mean over parts).
+    let calibrate = |model: &std::path::Path, out: &std::path::Path, flags: &[&str]| {
+        let mut command = amber();
+        command.args(["calibrate", "--model"]).arg(model).arg("--data").arg(data.join("test")).arg("-o").arg(out);
+        let output = command.args(flags).output().unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        let predictor = std::fs::read_to_string(out.join("predictor.json")).unwrap();
+        serde_json::from_str::<serde_json::Value>(&predictor).unwrap()["limits"]["final_count"].clone()
+    };
     let calibrated = dir.path().join("calibrated");
-    let output = amber()
-        .args(["calibrate", "--model"])
-        .arg(&run)
-        .arg("--data")
-        .arg(data.join("test"))
-        .arg("-o")
-        .arg(&calibrated)
-        .output()
-        .unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        calibrate(&run, &calibrated, &[])["slope"].is_number(),
+        "the folder profile's count regression is refitted"
+    );
+    // A model trained without the count regression gains one only when asked.
+    let plain = dir.path().join("plain");
+    std::fs::create_dir(&plain).unwrap();
+    for file in std::fs::read_dir(run.join("model")).unwrap() {
+        let file = file.unwrap().path();
+        std::fs::copy(&file, plain.join(file.file_name().unwrap())).unwrap();
+    }
+    let mut predictor = predictor;
+    predictor["limits"].as_object_mut().unwrap().remove("final_count");
+    std::fs::write(plain.join("predictor.json"), predictor.to_string()).unwrap();
+    assert!(calibrate(&plain, &dir.path().join("scale-only"), &[]).is_null());
+    let slope = calibrate(&plain, &dir.path().join("regressed"), &["--count-regression"])["slope"].as_f64();
+    assert!(slope.is_some_and(|s| (0.0..=1.0).contains(&s)), "{slope:?}");
     let evaluation = evaluate(&calibrated, &data.join("test"), &dir.path().join("evaluation-calibrated"));
     let log_ratios: Vec<f64> = evaluation["parts"]
         .as_array()

@@ -9,7 +9,7 @@ use amber_tasks::{Domain, LOG_SIZE_COLUMN, MeshLimits, Problem};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, TrainError};
-use crate::rollout::{FinalStep, GeneratedStep, fit_final_step, generate};
+use crate::rollout::{FinalStep, FinalStepFit, GeneratedStep, fit_final_step, generate};
 use crate::{
     AmberModel, CNN_PREDICTOR_FILE, CnnConfig, CnnModel, CnnTraining, DataConfig, Evaluation, MODEL_DIR, Rollout,
     Training, TrainingConfig, TrainingObserver,
@@ -169,8 +169,13 @@ impl TrainedModel {
 
     /// Fits the model's final step scale to the element counts of the experts of `problems`
     /// after `steps` generation steps ([`fit_final_step`]), replacing any earlier one, and its
-    /// count regression if it has one; returns the scale.
-    pub fn calibrate<const D: usize, P: Problem<D>>(&mut self, problems: &[P], steps: usize) -> Result<f64> {
+    /// count regression if it has one or `count_regression` asks for one; returns the fit.
+    pub fn calibrate<const D: usize, P: Problem<D>>(
+        &mut self,
+        problems: &[P],
+        steps: usize,
+        count_regression: bool,
+    ) -> Result<FinalStepFit> {
         self.limits_mut().final_step_scale = 1.0;
         let had_count = self.limits_mut().final_count.take().is_some();
         let fit = match self {
@@ -178,8 +183,8 @@ impl TrainedModel {
             TrainedModel::Cnn(m) => fit_final_step(&m.sizing(), problems, steps)?,
         };
         self.limits_mut().final_step_scale = fit.scale;
-        self.limits_mut().final_count = had_count.then_some(fit.count);
-        Ok(fit.scale)
+        self.limits_mut().final_count = (had_count || count_regression).then_some(fit.count);
+        Ok(fit)
     }
 
     /// Writes everything but the weights (normalisers, limits) into the model directory `dir`,
