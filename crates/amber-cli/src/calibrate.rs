@@ -1,12 +1,13 @@
 //! `amber calibrate`: a trained model re-fitted to the element counts of a folder of expert
 //! meshes (its final step scale and count regression, see `amber_train::fit_final_step`),
-//! written as a new model directory: where a team's experts mesh finer or coarser overall than
-//! the ones the model learned from, a handful of their meshes set the model's default element
-//! budget.
+//! written as a new model directory whose card records the calibration (and keeps the scores it
+//! held, which were the replaced predictor's, apart): where a team's experts mesh finer or coarser
+//! overall than the ones the model learned from, a handful of their meshes set the model's
+//! default element budget.
 
 use std::path::{Path, PathBuf};
 
-use amber_experiments::{ModelCard, Task};
+use amber_experiments::{CardCalibration, ModelCard, Task, commit};
 use amber_tasks::folder::{DatasetSettings, FolderDomain, Split, problems, read_experts};
 use amber_tasks::part::{PlanarPart, SolidPart};
 use amber_train::{FinalStepFit, TrainedModel};
@@ -53,10 +54,19 @@ pub fn run(args: CalibrateArgs) -> anyhow::Result<()> {
     };
     copy_model(&dir, &args.out)?;
     model.write_predictor(&args.out)?;
-    let count = match model.limits().final_count {
-        Some(count) => format!("; count regression slope {:.3}", count.slope),
-        None => String::new(),
-    };
+    let slope = model.limits().final_count.map(|count| count.slope);
+    let mut card = card;
+    card.calibration = Some(CardCalibration {
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        data: split.display().to_string(),
+        commit: commit().to_owned(),
+        steps,
+        final_step_scale: fit.scale,
+        count_regression_slope: slope,
+        evaluation_before: card.evaluation.take(),
+    });
+    card.write(&args.out)?;
+    let count = slope.map_or(String::new(), |slope| format!("; count regression slope {slope:.3}"));
     println!(
         "final step scale {:.4} (was {before:.4}){count}, fitted on {} after {steps} steps; wrote {}",
         fit.scale,

@@ -90,6 +90,7 @@ impl TrainingArgs {
             commit: commit().to_owned(),
             training_seconds: trained.seconds,
             evaluation: None,
+            calibration: None,
         };
         card.write(model)?;
         Ok(card)

@@ -548,6 +548,16 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
         calibrate(&run, &calibrated, &[])["slope"].is_number(),
         "the folder profile's count regression is refitted"
     );
+    // The card says how and on what the new predictor was fitted.
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(calibrated.join("card.json")).unwrap()).unwrap();
+    let fitted: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(calibrated.join("predictor.json")).unwrap()).unwrap();
+    let calibration = &card["calibration"];
+    assert_eq!(calibration["data"], data.join("test").display().to_string(), "{card}");
+    assert_eq!(calibration["final_step_scale"], fitted["limits"]["final_step_scale"], "{card}");
+    assert_eq!(calibration["count_regression_slope"], fitted["limits"]["final_count"]["slope"], "{card}");
+    assert!(calibration["command"].as_str().unwrap().contains("calibrate") && card["evaluation"].is_null());
     // A model trained without the count regression gains one only when asked.
     let plain = dir.path().join("plain");
     std::fs::create_dir(&plain).unwrap();

@@ -34,8 +34,30 @@ pub struct ModelCard {
     pub commit: String,
     /// Wall time of the training, seconds.
     pub training_seconds: f64,
-    /// Scores on held-out problems, when the command evaluated it.
+    /// Scores on held-out problems, when the command evaluated it (and no calibration has
+    /// changed its predictor since).
     pub evaluation: Option<CardEvaluation>,
+    /// The last re-fit of its final step by `amber calibrate`, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<CardCalibration>,
+}
+
+/// How `amber calibrate` re-fitted a model's final step on a folder of expert meshes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CardCalibration {
+    /// The command, as it was run.
+    pub command: String,
+    /// The expert meshes it was fitted on.
+    pub data: String,
+    /// The commit of the code that fitted it.
+    pub commit: String,
+    /// Generation steps the fit was made for.
+    pub steps: usize,
+    pub final_step_scale: f64,
+    /// The count regression's slope, when the model has one.
+    pub count_regression_slope: Option<f64>,
+    /// The scores the card held before, those of the predictor the calibration replaced.
+    pub evaluation_before: Option<CardEvaluation>,
 }
 
 /// A model's scores on the problems it was evaluated on.
@@ -134,6 +156,7 @@ mod tests {
             commit: "5952202".into(),
             training_seconds: 1.0,
             evaluation: None,
+            calibration: None,
         }
     }
 

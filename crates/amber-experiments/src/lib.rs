@@ -22,7 +22,7 @@ mod results;
 mod run;
 mod table;
 
-pub use card::{CARD_FILE, CardEvaluation, ModelCard, resolve_model};
+pub use card::{CARD_FILE, CardCalibration, CardEvaluation, ModelCard, resolve_model};
 pub use console::ConsoleExperiment;
 pub use folder::{FolderTraining, train_folder};
 pub use grid::{CachePolicy, PlannedRun};

@@ -126,6 +126,7 @@ impl Run {
             commit: String::new(),
             training_seconds: 0.0,
             evaluation: None,
+            calibration: None,
         };
         Self { key, dir, label, test_name: test_name.into(), eval_dir, card }
     }
