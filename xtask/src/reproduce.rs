@@ -4,7 +4,7 @@
 //! `data/runs/`, keyed by their config; `--plan`, `--only` and `--collect` hand the runs to a
 //! scheduler (`plan.rs`).
 
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 use amber_experiments::{ConsoleExperiment, ExperimentResults, Method, MethodSpec, PlannedRun, PoissonExperiment};
 use amber_stdx::read_json;
@@ -132,6 +132,17 @@ impl OverrideArgs {
     }
 }
 
+/// `path` relative to the directory `from` (through `..` where they part), both resolved; as
+/// given when either does not exist (the experiment then names what is missing).
+fn seen_from(path: &Path, from: &Path) -> PathBuf {
+    let (Ok(path_abs), Ok(from_abs)) = (path.canonicalize(), from.canonicalize()) else { return path.to_owned() };
+    let shared = path_abs.components().zip(from_abs.components()).take_while(|(a, b)| a == b).count();
+    let ups = from_abs.components().count() - shared;
+    let seen: PathBuf =
+        std::iter::repeat_n(Component::ParentDir, ups).chain(path_abs.components().skip(shared)).collect();
+    if seen.as_os_str().is_empty() { PathBuf::from(".") } else { seen }
+}
+
 pub fn run(args: Args) -> anyhow::Result<()> {
     match args.experiment {
         Experiment::Poisson(args) => poisson(args),
@@ -143,7 +154,9 @@ fn console(args: ConsoleArgs) -> anyhow::Result<()> {
     let default_out = if args.folds.is_some() { "results/console-cv" } else { "results/console" };
     let out = args.out.unwrap_or_else(|| default_out.into());
     report::check_provenance(&out, Some(args.allow_dirty))?;
-    let mut experiment = ConsoleExperiment::new(args.profile, &args.data);
+    // Run keys hash the data path: every spelling of one directory gets the same.
+    let data = seen_from(&args.data, Path::new("."));
+    let mut experiment = ConsoleExperiment::new(args.profile, &data);
     if args.all_train {
         experiment.train_set = TrainSet::All;
     }
@@ -261,4 +274,22 @@ fn report(results: &ExperimentResults, out: &Path) {
         );
     }
     println!("wrote {}/{{results.json, table.md, *.png}}", out.display());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_spelling_of_a_directory_is_seen_alike_from_another() {
+        let dir = tempfile::tempdir().unwrap();
+        let (root, data) = (dir.path().join("work/main"), dir.path().join("work/shared/data"));
+        std::fs::create_dir_all(&root).unwrap();
+        std::fs::create_dir_all(&data).unwrap();
+        let expected = PathBuf::from("../shared/data");
+        assert_eq!(seen_from(&data, &root), expected);
+        assert_eq!(seen_from(&root.join("../shared/./data"), &root), expected);
+        assert_eq!(seen_from(&root, &root), PathBuf::from("."));
+        assert_eq!(seen_from(&root.join("sub"), &root), root.join("sub"), "a missing path stays as given");
+    }
 }
