@@ -38,7 +38,7 @@ pub fn run(args: CalibrateArgs) -> anyhow::Result<()> {
     let split = if train.is_dir() { train } else { args.data.clone() };
     let loaded = args.model.load()?;
     loaded.check_dimension(&split)?;
-    let LoadedModel { dir, card, mut model, steps } = loaded;
+    let LoadedModel { dir, mut card, mut model, steps } = loaded;
     let settings = DatasetSettings::read(split.parent().unwrap_or(Path::new(".")))?;
     let before = model.limits().final_step_scale;
     let count_regression = args.count_regression;
@@ -55,7 +55,6 @@ pub fn run(args: CalibrateArgs) -> anyhow::Result<()> {
     copy_model(&dir, &args.out)?;
     model.write_predictor(&args.out)?;
     let slope = model.limits().final_count.map(|count| count.slope);
-    let mut card = card;
     card.calibration = Some(CardCalibration {
         command: std::env::args().collect::<Vec<_>>().join(" "),
         data: split.display().to_string(),
