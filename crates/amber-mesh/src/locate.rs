@@ -34,6 +34,10 @@ pub struct PointLocator<'m, const D: usize> {
     mesh: &'m Mesh<D>,
     boxes: RTree<GeomWithData<Rectangle<[f64; D]>, u32>>,
     midpoints: RTree<GeomWithData<[f64; D], u32>>,
+    /// Each element's signed volume, the denominator of its barycentric coordinates, computed
+    /// once rather than per candidate (most candidates are rejected after one or two
+    /// coordinates).
+    volumes: Vec<f64>,
 }
 
 impl<'m, const D: usize> PointLocator<'m, D> {
@@ -56,7 +60,8 @@ impl<'m, const D: usize> PointLocator<'m, D> {
             })
             .collect();
         let midpoints = mesh.midpoints().into_iter().enumerate().map(|(e, m)| GeomWithData::new(m, e as u32)).collect();
-        Self { mesh, boxes: RTree::bulk_load(boxes), midpoints: RTree::bulk_load(midpoints) }
+        let volumes = (0..mesh.num_elements()).map(|e| signed_volume::<D>(mesh.vertices(), mesh.element(e))).collect();
+        Self { mesh, boxes: RTree::bulk_load(boxes), midpoints: RTree::bulk_load(midpoints), volumes }
     }
 
     /// The mesh being queried.
@@ -102,7 +107,7 @@ impl<'m, const D: usize> PointLocator<'m, D> {
     fn containment_depth(&self, e: usize, p: [f64; D]) -> Option<f64> {
         let cell = self.mesh.element(e);
         let vertices = self.mesh.vertices();
-        let volume = signed_volume::<D>(vertices, cell);
+        let volume = self.volumes[e];
         let mut local: [[f64; D]; 4] = [[0.0; D]; 4];
         for (j, &v) in cell.iter().enumerate() {
             local[j] = vertices[v as usize];
