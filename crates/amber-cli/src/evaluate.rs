@@ -9,6 +9,8 @@ use amber_experiments::{ModelCard, ProblemEvaluation, Task, resolve_model, write
 use amber_mesh::Mesh;
 use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{Tile, mesh_gallery};
+
+use crate::mesh::check_faces;
 use amber_tasks::Problem;
 use amber_tasks::folder::{DatasetSettings, Expert, FolderDomain, Split, mesh_dimension, problems, read_experts};
 use amber_tasks::part::{PlanarPart, SolidPart};
@@ -191,6 +193,9 @@ impl PartScorer<'_> {
     {
         let names: Vec<String> = experts.iter().map(|e| e.name.clone()).collect();
         let parts = problems::<D, P>(experts, self.initial_size, self.settings)?;
+        for (name, part) in names.iter().zip(&parts) {
+            check_faces(name, part, self.model);
+        }
         let evaluation = Evaluation::new(&parts, self.model.limits())?;
         let rollouts = self.model.rollouts(&evaluation, self.steps)?;
         std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;

@@ -140,6 +140,13 @@ pub(crate) fn polygon_domain_of_mesh(path: &Path, mesh: &Mesh2) -> Result<Polygo
 pub const GEOMETRY_INPUTS: [&str; 5] =
     ["log_boundary_distance", "log_feature_distance", "feature_turn", "log_curvature_radius", "log_wall_thickness"];
 
+/// The [`GEOMETRY_INPUTS`] that read a solid's faces (the feature curves where two faces meet,
+/// the curvature within a face): a surface whose faces were found at its sharp edges, not given
+/// as CAD faces, misses the tangent edges between CAD faces (a fillet's), and a model trained on
+/// CAD faces reads them differently there (docs/PROFILES.md: the shipped Console model's val
+/// 0.167 → 0.584).
+pub const FACE_INPUTS: [&str; 3] = ["log_feature_distance", "feature_turn", "log_curvature_radius"];
+
 /// The columns of [`GEOMETRY_INPUTS`] for elements with midpoints `midpoints`, given the distance
 /// to the boundary of a point with the boundary's radius of curvature there, its distance to
 /// the nearest feature with the feature's turn, and the wall's thickness there. Lengths are
@@ -319,6 +326,10 @@ impl Domain<3> for SolidPart {
 
     fn domain_name(&self) -> Option<String> {
         self.surface.solid_name().map(str::to_owned)
+    }
+
+    fn faces_split_at(&self) -> Option<f64> {
+        self.surface.faces_split_at()
     }
 }
 

@@ -31,6 +31,9 @@ pub struct Surface {
     face_names: BTreeMap<i32, String>,
     /// The name of the solid the surface bounds, where the geometry gives one.
     solid_name: Option<String>,
+    /// The angle (degrees) at whose feature edges the faces were found, where the geometry gave
+    /// no CAD faces.
+    faces_split_at: Option<f64>,
     /// Whether [`Surface::validate`] succeeded (nothing can change the surface afterwards).
     valid: bool,
 }
@@ -151,7 +154,15 @@ impl Surface {
                 });
             }
         }
-        Ok(Self { vertices, triangles, face_ids, face_names: BTreeMap::new(), solid_name: None, valid: false })
+        Ok(Self {
+            vertices,
+            triangles,
+            face_ids,
+            face_names: BTreeMap::new(),
+            solid_name: None,
+            faces_split_at: None,
+            valid: false,
+        })
     }
 
     /// Builds a surface from a triangle soup (3 corners per triangle, as in STL), merging
@@ -262,6 +273,7 @@ impl Surface {
         }
         self.face_ids = face;
         self.face_names.clear();
+        self.faces_split_at = Some(angle_degrees);
         self.valid = false;
     }
 
@@ -337,6 +349,12 @@ impl Surface {
     /// The name of the solid the surface bounds, where the geometry gives one.
     pub fn solid_name(&self) -> Option<&str> {
         self.solid_name.as_deref()
+    }
+
+    /// The feature angle (degrees) at which [`Surface::split_faces_at_feature_edges`] found the
+    /// faces, or `None` where they are the geometry's own (CAD faces, groups).
+    pub fn faces_split_at(&self) -> Option<f64> {
+        self.faces_split_at
     }
 
     /// Signed enclosed volume (divergence theorem; positive for a closed outward surface).
@@ -618,8 +636,10 @@ mod tests {
     #[test]
     fn feature_edges_split_faces_and_mesh_boundaries_bound_the_mesh() {
         let mut s = cube();
+        assert_eq!(s.faces_split_at(), None);
         s.face_ids.iter_mut().for_each(|id| *id = 7);
         s.split_faces_at_feature_edges(30.0);
+        assert_eq!(s.faces_split_at(), Some(30.0));
         let mut ids = s.face_ids().to_vec();
         ids.sort();
         ids.dedup();
