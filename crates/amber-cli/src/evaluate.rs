@@ -9,8 +9,6 @@ use amber_experiments::{ModelCard, ProblemEvaluation, Task, resolve_model, write
 use amber_mesh::Mesh;
 use amber_metrics::{SizeRatios, log_size_ratios};
 use amber_plot::{Tile, mesh_gallery};
-
-use crate::mesh::check_faces;
 use amber_tasks::Problem;
 use amber_tasks::folder::{DatasetSettings, Expert, FolderDomain, Split, mesh_dimension, problems, read_experts};
 use amber_tasks::part::{PlanarPart, SolidPart};
@@ -19,7 +17,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use serde::Serialize;
 
-use crate::mesh::{Picture, shipped_models};
+use crate::mesh::{Picture, check_faces, shipped_models};
 
 /// A trained model to roll out on a folder of expert meshes, and for how many steps.
 #[derive(Args)]
