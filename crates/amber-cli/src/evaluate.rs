@@ -17,7 +17,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use serde::Serialize;
 
-use crate::mesh::{Picture, check_faces, shipped_models};
+use crate::mesh::{Picture, shipped_models};
 
 /// A trained model to roll out on a folder of expert meshes, and for how many steps.
 #[derive(Args)]
@@ -191,9 +191,6 @@ impl PartScorer<'_> {
     {
         let names: Vec<String> = experts.iter().map(|e| e.name.clone()).collect();
         let parts = problems::<D, P>(experts, self.initial_size, self.settings)?;
-        for (name, part) in names.iter().zip(&parts) {
-            check_faces(name, part, self.model);
-        }
         let evaluation = Evaluation::new(&parts, self.model.limits())?;
         let rollouts = self.model.rollouts(&evaluation, self.steps)?;
         std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;

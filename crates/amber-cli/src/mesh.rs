@@ -19,8 +19,8 @@ use amber_plot::{RenderOptions, TileMesh, View, render_png, render_surface_png};
 use amber_stdx::{median, quantile};
 use amber_tasks::cad::is_cad;
 use amber_tasks::part::{
-    FACE_INPUTS, FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, cad_face_tags, polygon_side_tags,
-    read_polygon_domain, read_solid_surface,
+    FEATURE_ANGLE_DEGREES, PartInputs, PlanarPart, SolidPart, cad_face_tags, polygon_side_tags, read_polygon_domain,
+    read_solid_surface,
 };
 use amber_tasks::poisson::{PoissonPart, read_part};
 use amber_tasks::{Domain, RefineBox, RefineFace, SizeBounds, WithExpert};
@@ -101,7 +101,7 @@ pub struct MeshArgs {
     #[arg(long)]
     every_step: Option<PathBuf>,
     /// Surfaces without CAD faces (a plain STL, a mesh without boundary groups) are split into
-    /// faces at edges sharper than this many degrees.
+    /// faces at edges sharper than this many degrees, and where a flat face meets a curved one.
     #[arg(long, default_value_t = FEATURE_ANGLE_DEGREES)]
     feature_angle: f64,
     /// Refuse to build more elements than this. A model's own field is first held to the model's
@@ -248,7 +248,6 @@ fn with_model(args: &MeshArgs, model: &str) -> anyhow::Result<()> {
             let surface = read_solid_surface(path, args.feature_angle, card.initial_size)?;
             let mut part = SolidPart::new(part_name(geometry), surface, card.initial_size)
                 .with_context(|| initial_mesh_failed(geometry, card.initial_size))?;
-            check_faces(geometry, &part, &trained);
             check_initial_mesh(&part.initial_mesh, card.initial_size);
             part.inputs = part_inputs(args)?;
             let expert = args.expert.as_ref().map(|p| read_mesh::<3>(p).map(|m| (m, p.clone()))).transpose()?;
@@ -302,24 +301,6 @@ fn check_initial_mesh<const D: usize>(initial_mesh: &Mesh<D>, initial_size: f64)
             "warning: the part is small for this model: M⁰'s elements are {:.1e} of the model's initial size. Is \
              the geometry in the units of the model's training parts?",
             median / initial_size
-        );
-    }
-}
-
-/// Warns when the model reads the faces of a solid (its feature curves, its curvature within a
-/// face) but the geometry gave none, so that they were found at its sharp edges instead: the
-/// tangent edges between CAD faces that the model learned from are then missing.
-pub(crate) fn check_faces<const D: usize>(geometry: &str, domain: &impl Domain<D>, model: &TrainedModel) {
-    let Some(angle) = domain.faces_split_at() else { return };
-    let read: Vec<&str> = FACE_INPUTS.into_iter().filter(|input| model.reads_column(input)).collect();
-    if !read.is_empty() {
-        eprintln!(
-            "warning: {geometry} has no CAD faces, so its faces were found at edges sharper than {angle}°, \
-             without the tangent edges between CAD faces; this model reads them ({}) and meshes far less like its \
-             experts without them (the Console model: normalised DCD 0.167 → 0.584 on its val parts). Give the CAD \
-             file (.step, .iges, .brep) or a surface with its CAD faces (STL facet attributes or `solid` blocks, \
-             OBJ groups, mesh boundary groups)",
-            read.join(", ")
         );
     }
 }

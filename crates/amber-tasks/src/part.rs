@@ -30,7 +30,8 @@ pub const FEATURE_ANGLE_DEGREES: f64 = 30.0;
 /// [`TESSELLATION_SIZE_PER_INITIAL_SIZE`] × `initial_size`, M⁰'s element size), or the boundary
 /// of a tet mesh in any format amber reads (its faces the file's boundary groups). A surface
 /// with a single face (a plain STL, a mesh boundary without groups) is split into faces at
-/// edges sharper than `feature_angle` degrees, since the generator keeps vertices on their own
+/// edges sharper than `feature_angle` degrees and at tangent edges (where a flat face meets a
+/// curved one), since the generator keeps vertices on their own
 /// face and curves. The solid's name is a mesh file's domain group's, or the name of a surface's
 /// single face (an STL of one `solid NAME`, as CAD exporters write a part).
 pub fn read_solid_surface(path: &Path, feature_angle: f64, initial_size: f64) -> Result<Surface, TaskError> {
@@ -72,7 +73,7 @@ fn unreadable(path: &Path, error: MeshError, expected: &str) -> TaskError {
 
 /// The boundary of the tet mesh `mesh` (read from `path`) as a validated surface, its faces the
 /// file's `facet_tags` (physical groups, skin properties) named by `facet_names` when they name
-/// more than one, else split at edges sharper than `feature_angle` degrees.
+/// more than one, else found at edges sharper than `feature_angle` degrees and at tangent edges.
 pub(crate) fn solid_surface_of_mesh(
     path: &Path,
     mesh: &Mesh3,
@@ -139,13 +140,6 @@ pub(crate) fn polygon_domain_of_mesh(path: &Path, mesh: &Mesh2) -> Result<Polygo
 /// They come from the geometry alone, so every dataset has them.
 pub const GEOMETRY_INPUTS: [&str; 5] =
     ["log_boundary_distance", "log_feature_distance", "feature_turn", "log_curvature_radius", "log_wall_thickness"];
-
-/// The [`GEOMETRY_INPUTS`] that read a solid's faces (the feature curves where two faces meet,
-/// the curvature within a face): a surface whose faces were found at its sharp edges, not given
-/// as CAD faces, misses the tangent edges between CAD faces (a fillet's), and a model trained on
-/// CAD faces reads them differently there (docs/PROFILES.md: the shipped Console model's val
-/// 0.167 → 0.584).
-pub const FACE_INPUTS: [&str; 3] = ["log_feature_distance", "feature_turn", "log_curvature_radius"];
 
 /// The columns of [`GEOMETRY_INPUTS`] for elements with midpoints `midpoints`, given the distance
 /// to the boundary of a point with the boundary's radius of curvature there, its distance to
@@ -327,10 +321,6 @@ impl Domain<3> for SolidPart {
     fn domain_name(&self) -> Option<String> {
         self.surface.solid_name().map(str::to_owned)
     }
-
-    fn faces_split_at(&self) -> Option<f64> {
-        self.surface.faces_split_at()
-    }
 }
 
 /// Every boundary triangle of `mesh` (a mesh of the solid `distance` measures), keyed by its
@@ -478,6 +468,22 @@ mod tests {
 
     /// The unit cube with its six sides as CAD faces 1..=6 (z = 0, z = 1, y = 0, y = 1, x = 0,
     /// x = 1), meshed at size 0.3.
+    /// M⁰ of the boundary of an expert mesh (reads `../shared/data/console`) at the sizes where
+    /// TetGen failed on every remeshed surface with the background mesh of its vertices: filled,
+    /// its tets the solid's volume (within the chords' loss on curved faces).
+    #[test]
+    fn an_expert_mesh_boundary_fills_at_every_initial_size() {
+        let Some(data) = amber_testdata::shared("data/console") else { return };
+        let path = data.join("train/015.nas");
+        for h in [4.75, 5.45] {
+            let surface = read_solid_surface(&path, FEATURE_ANGLE_DEGREES, h).unwrap();
+            let volume = surface.enclosed_volume();
+            let part = SolidPart::new("015".into(), surface, h).unwrap_or_else(|e| panic!("M⁰ at {h}: {e}"));
+            let filled = part.initial_mesh.total_volume();
+            assert!((filled / volume - 1.0).abs() < 5e-3, "M⁰ at {h}: {filled} for {volume}");
+        }
+    }
+
     fn unit_cube_part() -> SolidPart {
         let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
         let sides = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];

@@ -81,11 +81,6 @@ pub trait Domain<const D: usize>: Sync {
     fn domain_name(&self) -> Option<String> {
         None
     }
-    /// The feature angle (degrees) at whose sharp edges a solid's faces were found where its
-    /// geometry gave no CAD faces; `None` where the faces are the geometry's own.
-    fn faces_split_at(&self) -> Option<f64> {
-        None
-    }
 }
 
 /// One problem of a learning task in `D` dimensions: a domain with the expert's mesh of it.
@@ -148,10 +143,6 @@ impl<const D: usize, P: Domain<D>> Domain<D> for WithExpert<P, D> {
 
     fn domain_name(&self) -> Option<String> {
         self.domain.domain_name()
-    }
-
-    fn faces_split_at(&self) -> Option<f64> {
-        self.domain.faces_split_at()
     }
 }
 

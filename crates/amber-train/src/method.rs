@@ -199,12 +199,6 @@ impl TrainedModel {
         Ok(amber_stdx::write_json_atomic(&path, &json)?)
     }
 
-    /// Whether the model reads the per-element column `name` (the CNN reads none).
-    pub fn reads_column(&self, name: &str) -> bool {
-        let TrainedModel::Amber(m) = self else { return false };
-        m.predictor.features.node.iter().any(|f| matches!(f, NodeFeature::Column(column) if column == name))
-    }
-
     /// Whether `domain` offers every per-element column the model reads beyond the geometric
     /// features and log h(K) (the CNN reads none).
     pub fn check_inputs<const D: usize, P: Domain<D>>(&self, domain: &P) -> Result<()> {

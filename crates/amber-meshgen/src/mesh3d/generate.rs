@@ -112,7 +112,7 @@ impl From<Mesh3dError> for crate::MeshgenError {
 /// lengths, spec §0): [`adapt_surface`], then [`fill_surface`]. Deterministic: the same
 /// inputs give the same mesh. A remeshed surface that TetGen cannot fill even with its looser
 /// quality bounds (its internal error) is remeshed again at slightly smaller sizes, which moves
-/// every surface vertex, and filled again.
+/// every surface vertex, and filled again; failing that, filled without the background mesh.
 pub fn generate_3d(
     reference: &Surface,
     field: &impl SizingField<3>,
@@ -127,6 +127,15 @@ pub fn generate_3d(
             }
             _ => break,
         }
+    }
+    if let Err(Mesh3dError::Tetgen(TetgenError::Internal)) = out {
+        // The background mesh is where the error comes from when every retry fails (the
+        // boundary of the expert mesh train/015.nas at an M⁰ size of 5.45: without it, TetGen
+        // fills each retry's surface): the sizes at the surface's vertices alone, which TetGen
+        // interpolates inside.
+        let surface = adapt_surface(reference, field, params)?;
+        let sizes = surface_sizes(&surface, field, params)?;
+        out = fill_sampled(&surface, &sizes, None, params);
     }
     out
 }
@@ -193,10 +202,10 @@ pub fn fill_surface(
     params: &Mesh3dParams,
 ) -> Result<Mesh3, Mesh3dError> {
     let sized = |p: [f64; 3]| checked_size(field, p).map(|h| params.size_factor * h);
-    let sizes = surface.vertices().iter().map(|&p| sized(p)).collect::<Result<Vec<_>, _>>()?;
+    let sizes = surface_sizes(surface, field, params)?;
     let mut samples = surface.vertices().to_vec();
     let mut sample_sizes = sizes.clone();
-    let mut mesh = fill_sampled(surface, &sizes, (&samples, &sample_sizes), params)?;
+    let mut mesh = fill_sampled(surface, &sizes, Some((&samples, &sample_sizes)), params)?;
     let mut sampled = HashSet::new();
     for _ in 0..INTERIOR_PASSES {
         // The field at the misfit tets' midpoints and corners (a tet the last pass left as it
@@ -215,9 +224,18 @@ pub fn fill_surface(
             samples.push(p);
             sample_sizes.push(sized(p)?);
         }
-        mesh = fill_sampled(surface, &sizes, (&samples, &sample_sizes), params)?;
+        mesh = fill_sampled(surface, &sizes, Some((&samples, &sample_sizes)), params)?;
     }
     Ok(mesh)
+}
+
+/// The field (scaled by the params' size factor) at every vertex of `surface`.
+fn surface_sizes(
+    surface: &Surface,
+    field: &impl SizingField<3>,
+    params: &Mesh3dParams,
+) -> Result<Vec<f64>, Mesh3dError> {
+    surface.vertices().iter().map(|&p| checked_size(field, p).map(|h| params.size_factor * h)).collect()
 }
 
 /// A tet deeper inside the solid than this many sizes (its own or the field's, the smaller) is
@@ -279,19 +297,19 @@ fn misfit_interior(mesh: &Mesh3, surface: &Surface, field: &impl SizingField<3>)
 }
 
 /// One TetGen fill of `surface` with `sizes` at its vertices and the background mesh of the
-/// field's `samples` (points and sizes).
+/// field's `samples` (points and sizes), where given.
 fn fill_sampled(
     surface: &Surface,
     sizes: &[f64],
-    samples: (&[[f64; 3]], &[f64]),
+    samples: Option<(&[[f64; 3]], &[f64])>,
     params: &Mesh3dParams,
 ) -> Result<Mesh3, Mesh3dError> {
-    let background = convex_background(samples.0, samples.1, BACKGROUND_PADDING)?;
+    let background = samples.map(|(points, sizes)| convex_background(points, sizes, BACKGROUND_PADDING)).transpose()?;
     // TetGen's Steiner-point cap: a mesh with `max_elements` tets has far fewer points, so
     // reaching it means the cap is exceeded.
     let switches = TetgenSwitches { max_steiner_points: Some(params.max_elements), ..params.switches };
     let plc = surface.to_plc();
-    let background = Some(&background);
+    let background = background.as_ref();
     let mut out = tetrahedralize(&plc, Some(sizes), background, &switches);
     for quality in FALLBACK_QUALITY {
         match out {

@@ -31,9 +31,6 @@ pub struct Surface {
     face_names: BTreeMap<i32, String>,
     /// The name of the solid the surface bounds, where the geometry gives one.
     solid_name: Option<String>,
-    /// The angle (degrees) at whose feature edges the faces were found, where the geometry gave
-    /// no CAD faces.
-    faces_split_at: Option<f64>,
     /// Whether [`Surface::validate`] succeeded (nothing can change the surface afterwards).
     valid: bool,
 }
@@ -154,15 +151,7 @@ impl Surface {
                 });
             }
         }
-        Ok(Self {
-            vertices,
-            triangles,
-            face_ids,
-            face_names: BTreeMap::new(),
-            solid_name: None,
-            faces_split_at: None,
-            valid: false,
-        })
+        Ok(Self { vertices, triangles, face_ids, face_names: BTreeMap::new(), solid_name: None, valid: false })
     }
 
     /// Builds a surface from a triangle soup (3 corners per triangle, as in STL), merging
@@ -234,46 +223,84 @@ impl Surface {
         Self::new(vertices, triangles, face_ids).map_err(|source| SurfaceError::Defect { path: PathBuf::new(), source })
     }
 
-    /// Splits the faces at feature edges, for surfaces whose files carry no CAD faces: two
-    /// triangles across an edge stay in one face when they were in one face and their normals
-    /// differ by at most `angle_degrees`. Faces are renumbered from 1 in the order of their first
-    /// triangle, without names. The surface must be validated again.
+    /// Finds faces as a CAD model would have them, for surfaces whose files carry none: two
+    /// triangles across an edge share a face when they were in one face, their normals differ by
+    /// at most `angle_degrees`, and the edge is not where a flat region meets a curved one (the
+    /// tangent edge of a fillet, a bend or a hole, which no angle shows). Faces are renumbered
+    /// from 1 in the order of their first triangle, without names. The surface must be
+    /// validated again.
+    ///
+    /// A flat region is a patch of triangles joined across edges below [`FLAT_EDGE_DEGREES`] that
+    /// is wider than [`FLAT_PATCH_WIDTH_RATIO`] × its narrowest neighbour across a bent edge: a
+    /// curved face's patches (single triangles of an irregular mesh, the coplanar strips of a
+    /// tessellated cylinder) are about as wide as their neighbours, a plane beside a fillet is
+    /// many times wider than the fillet's patches.
     pub fn split_faces_at_feature_edges(&mut self, angle_degrees: f64) {
         let normal = |t: &[u32; 3]| {
             let p = |k: usize| Vector3::from(self.vertices[t[k] as usize]);
             (p(1) - p(0)).cross(&(p(2) - p(0))).normalize()
         };
         let normals: Vec<Vector3<f64>> = self.triangles.iter().map(normal).collect();
-        let cos_limit = angle_degrees.to_radians().cos();
-        let by_edge = self.edge_triangles();
-        let mut face = vec![0i32; self.triangles.len()];
-        let mut next_id = 0;
-        let mut queue = VecDeque::new();
-        for seed in 0..self.triangles.len() {
-            if face[seed] != 0 {
-                continue;
-            }
-            next_id += 1;
-            face[seed] = next_id;
-            queue.push_back(seed);
-            while let Some(t) = queue.pop_front() {
-                let tri = self.triangles[t];
-                for k in 0..3 {
-                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    for &u in &by_edge[&[a.min(b), a.max(b)]] {
-                        // A NaN normal (a sliver) compares false and stays out of the face.
-                        let smooth = normals[t].dot(&normals[u]) >= cos_limit;
-                        if face[u] == 0 && self.face_ids[u] == self.face_ids[t] && smooth {
-                            face[u] = next_id;
-                            queue.push_back(u);
-                        }
-                    }
+        let area = |t: &[u32; 3]| {
+            let p = |k: usize| Vector3::from(self.vertices[t[k] as usize]);
+            0.5 * (p(1) - p(0)).cross(&(p(2) - p(0))).norm()
+        };
+        // Every edge inside one of the given faces: its triangles, length and the angle between
+        // their normals (NaN for a sliver, which then joins nothing).
+        let edges: Vec<([usize; 2], f64, f64)> = self
+            .edge_triangles()
+            .into_iter()
+            .filter_map(|([a, b], around)| match around[..] {
+                [k, l] if self.face_ids[k] == self.face_ids[l] => {
+                    let length =
+                        (Vector3::from(self.vertices[a as usize]) - Vector3::from(self.vertices[b as usize])).norm();
+                    Some(([k, l], length, normals[k].dot(&normals[l]).clamp(-1.0, 1.0).acos()))
                 }
-            }
+                _ => None,
+            })
+            .collect();
+        let limit = angle_degrees.to_radians();
+        let flat_limit = FLAT_EDGE_DEGREES.to_radians();
+        let patch = components(self.triangles.len(), edges.iter().filter(|e| e.2 <= flat_limit).map(|e| e.0));
+        let patches = patch.iter().max().map_or(0, |&p| p + 1);
+        let mut patch_area = vec![0.0; patches];
+        for (t, tri) in self.triangles.iter().enumerate() {
+            patch_area[patch[t]] += area(tri);
         }
-        self.face_ids = face;
+        let mut bent_length = vec![0.0; patches];
+        let bent = |&&(_, _, angle): &&([usize; 2], f64, f64)| angle > flat_limit && angle <= limit;
+        for &([k, l], length, _) in edges.iter().filter(bent) {
+            bent_length[patch[k]] += length;
+            bent_length[patch[l]] += length;
+        }
+        let width: Vec<f64> = patch_area.iter().zip(&bent_length).map(|(a, b)| 2.0 * a / b).collect();
+        let mut narrowest_neighbour = vec![f64::INFINITY; patches];
+        for &([k, l], _, _) in edges.iter().filter(bent) {
+            let (p, q) = (patch[k], patch[l]);
+            narrowest_neighbour[p] = narrowest_neighbour[p].min(width[q]);
+            narrowest_neighbour[q] = narrowest_neighbour[q].min(width[p]);
+        }
+        let flat: Vec<bool> =
+            (0..patches).map(|p| width[p] > FLAT_PATCH_WIDTH_RATIO * narrowest_neighbour[p]).collect();
+        let joined = edges.iter().filter(|&&([k, l], _, angle)| {
+            let (p, q) = (patch[k], patch[l]);
+            p == q || (angle <= limit && !flat[p] && !flat[q])
+        });
+        let face = components(self.triangles.len(), joined.map(|e| e.0));
+        // Renumber from 1 in the order of the faces' first triangles.
+        let mut id = vec![0i32; self.triangles.len()];
+        let mut next_id = 0;
+        self.face_ids = face
+            .iter()
+            .map(|&f| {
+                if id[f] == 0 {
+                    next_id += 1;
+                    id[f] = next_id;
+                }
+                id[f]
+            })
+            .collect();
         self.face_names.clear();
-        self.faces_split_at = Some(angle_degrees);
         self.valid = false;
     }
 
@@ -349,12 +376,6 @@ impl Surface {
     /// The name of the solid the surface bounds, where the geometry gives one.
     pub fn solid_name(&self) -> Option<&str> {
         self.solid_name.as_deref()
-    }
-
-    /// The feature angle (degrees) at which [`Surface::split_faces_at_feature_edges`] found the
-    /// faces, or `None` where they are the geometry's own (CAD faces, groups).
-    pub fn faces_split_at(&self) -> Option<f64> {
-        self.faces_split_at
     }
 
     /// Signed enclosed volume (divergence theorem; positive for a closed outward surface).
@@ -560,6 +581,44 @@ fn find(parent: &mut [usize], mut x: usize) -> usize {
     x
 }
 
+/// The angle (degrees) below which two triangles count as coplanar when faces are found
+/// ([`Surface::split_faces_at_feature_edges`]): far above the rounding of coordinates printed
+/// with six digits, below a curved face's angle between neighbouring triangles.
+pub const FLAT_EDGE_DEGREES: f64 = 0.5;
+
+/// How many times wider than its narrowest bent neighbour a coplanar patch is to count as a flat
+/// face of its own ([`Surface::split_faces_at_feature_edges`]).
+pub const FLAT_PATCH_WIDTH_RATIO: f64 = 4.0;
+
+/// The connected components of `nodes` nodes joined by `links`: each node's component, numbered
+/// from 0 in the order of their smallest node.
+fn components(nodes: usize, links: impl Iterator<Item = [usize; 2]>) -> Vec<usize> {
+    let mut parent: Vec<usize> = (0..nodes).collect();
+    fn root(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for [a, b] in links {
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        parent[ra.max(rb)] = ra.min(rb);
+    }
+    let mut number = vec![usize::MAX; nodes];
+    let mut next = 0;
+    (0..nodes)
+        .map(|x| {
+            let r = root(&mut parent, x);
+            if number[r] == usize::MAX {
+                number[r] = next;
+                next += 1;
+            }
+            number[r]
+        })
+        .collect()
+}
+
 /// Merges corners into vertices: bit-identical positions for `tolerance == 0`, else any two
 /// within `tolerance` (grid hashing with cells of that size; the first vertex found wins).
 fn weld(corners: &[[f64; 3]], tolerance: f64) -> (Vec<[f64; 3]>, Vec<u32>) {
@@ -636,10 +695,8 @@ mod tests {
     #[test]
     fn feature_edges_split_faces_and_mesh_boundaries_bound_the_mesh() {
         let mut s = cube();
-        assert_eq!(s.faces_split_at(), None);
         s.face_ids.iter_mut().for_each(|id| *id = 7);
         s.split_faces_at_feature_edges(30.0);
-        assert_eq!(s.faces_split_at(), Some(30.0));
         let mut ids = s.face_ids().to_vec();
         ids.sort();
         ids.dedup();
@@ -660,6 +717,51 @@ mod tests {
         let report = boundary.validate().unwrap();
         assert_eq!(report.flipped_triangles, 0, "mesh boundaries come out oriented");
         assert!((report.enclosed_volume - mesh.total_volume()).abs() < 1e-12);
+    }
+
+    /// A box of 3 × 1 × 2 whose edge between the top and the side x = 3 is a fillet of radius
+    /// 0.5 in `strips` flat strips, as a CAD exporter tessellates it; one face id throughout.
+    fn filleted_box(strips: u32) -> Surface {
+        let (r, w) = (0.5, 1.0);
+        // The profile in the xz-plane, counter-clockwise from the origin; y is the extrusion.
+        let mut profile = vec![[0.0, 0.0], [3.0, 0.0]];
+        profile.extend((0..=strips).map(|k| {
+            let angle = std::f64::consts::FRAC_PI_2 * f64::from(k) / f64::from(strips);
+            [3.0 - r + r * angle.cos(), 2.0 - r + r * angle.sin()]
+        }));
+        profile.push([0.0, 2.0]);
+        let n = profile.len() as u32;
+        let mut vertices: Vec<[f64; 3]> =
+            [0.0, w].iter().flat_map(|&y| profile.iter().map(move |p| [p[0], y, p[1]])).collect();
+        vertices.extend([[1.5, 0.0, 1.0], [1.5, w, 1.0]]);
+        let mut triangles = Vec::new();
+        for k in 0..n {
+            let (a0, a1, b0, b1) = (k, (k + 1) % n, n + k, n + (k + 1) % n);
+            triangles.extend([[a0, b1, a1], [a0, b0, b1], [2 * n, a0, a1], [2 * n + 1, b1, b0]]);
+        }
+        let faces = vec![1; triangles.len()];
+        Surface::new(vertices, triangles, faces).unwrap()
+    }
+
+    /// The fillet's tangent edges have no angle, yet they bound faces as in the CAD model: the
+    /// fillet is one face between the top and the side, whether in one strip or in twelve, and
+    /// every face is a side of the box, the fillet or a cap.
+    #[test]
+    fn tangent_edges_bound_faces() {
+        for strips in [1, 3, 12] {
+            let mut s = filleted_box(strips);
+            s.split_faces_at_feature_edges(30.0);
+            let mut faces = s.face_ids().to_vec();
+            faces.sort();
+            faces.dedup();
+            assert_eq!(faces.len(), 7, "{strips} strips: {:?}", s.face_ids());
+            let n = strips + 4;
+            let fillet: Vec<i32> = (2..2 + strips).map(|k| s.face_ids()[4 * k as usize]).collect();
+            assert!(fillet.iter().all(|&f| f == fillet[0]), "{strips} strips: {fillet:?}");
+            let (side, top) = (s.face_ids()[4], s.face_ids()[4 * (n as usize - 2)]);
+            assert!(side != fillet[0] && top != fillet[0] && side != top, "{strips} strips: {:?}", s.face_ids());
+            s.validate().unwrap();
+        }
     }
 
     /// A mesh file's facet tags become the faces of its boundary; untagged facets share the
