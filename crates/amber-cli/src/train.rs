@@ -29,11 +29,12 @@ pub struct TrainingArgs {
     /// Console parts, results/), paper (GPU scale).
     #[arg(long, default_value = "quick")]
     profile: Profile,
-    /// amber-mean or amber-max: how the expert's sizes become labels on a coarser mesh. Max,
-    /// the default, varies less between training seeds on Console's validation parts
-    /// (normalised DCD 0.200 and 0.197 against Mean's 0.224 and 0.154, results/console) and
-    /// meshes Poisson as well (0.090 against 0.089, two seeds, results/poisson).
-    #[arg(long, default_value = "amber-max")]
+    /// amber-mean or amber-max: how the expert's sizes become labels on a coarser mesh. Mean,
+    /// the default, meshes the Console parts better with the profile's log objective
+    /// (normalised DCD 0.147 against Max's 0.157 on the val parts, 0.237 against 0.244 on
+    /// train/016–019, two seeds each, docs/PROFILES.md) and Poisson as well (0.089 against
+    /// 0.090, two seeds, results/poisson).
+    #[arg(long, default_value = "amber-mean")]
     pub method: Method,
     /// Training seed: selects the training problems and seeds the run.
     #[arg(long, default_value_t = 0)]
