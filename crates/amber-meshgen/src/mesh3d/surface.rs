@@ -236,15 +236,12 @@ impl Surface {
     /// tessellated cylinder) are about as wide as their neighbours, a plane beside a fillet is
     /// many times wider than the fillet's patches.
     pub fn split_faces_at_feature_edges(&mut self, angle_degrees: f64) {
-        let normal = |t: &[u32; 3]| {
+        let cross = |t: &[u32; 3]| {
             let p = |k: usize| Vector3::from(self.vertices[t[k] as usize]);
-            (p(1) - p(0)).cross(&(p(2) - p(0))).normalize()
+            (p(1) - p(0)).cross(&(p(2) - p(0)))
         };
-        let normals: Vec<Vector3<f64>> = self.triangles.iter().map(normal).collect();
-        let area = |t: &[u32; 3]| {
-            let p = |k: usize| Vector3::from(self.vertices[t[k] as usize]);
-            0.5 * (p(1) - p(0)).cross(&(p(2) - p(0))).norm()
-        };
+        let crosses: Vec<Vector3<f64>> = self.triangles.iter().map(cross).collect();
+        let normals: Vec<Vector3<f64>> = crosses.iter().map(|c| c.normalize()).collect();
         // Every edge inside one of the given faces: its triangles, length and the angle between
         // their normals (NaN for a sliver, which then joins nothing).
         let edges: Vec<([usize; 2], f64, f64)> = self
@@ -264,8 +261,8 @@ impl Surface {
         let patch = components(self.triangles.len(), edges.iter().filter(|e| e.2 <= flat_limit).map(|e| e.0));
         let patches = patch.iter().max().map_or(0, |&p| p + 1);
         let mut patch_area = vec![0.0; patches];
-        for (t, tri) in self.triangles.iter().enumerate() {
-            patch_area[patch[t]] += area(tri);
+        for (t, c) in crosses.iter().enumerate() {
+            patch_area[patch[t]] += 0.5 * c.norm();
         }
         let mut bent_length = vec![0.0; patches];
         let bent = |&&(_, _, angle): &&([usize; 2], f64, f64)| angle > flat_limit && angle <= limit;
@@ -287,19 +284,7 @@ impl Surface {
             p == q || (angle <= limit && !flat[p] && !flat[q])
         });
         let face = components(self.triangles.len(), joined.map(|e| e.0));
-        // Renumber from 1 in the order of the faces' first triangles.
-        let mut id = vec![0i32; self.triangles.len()];
-        let mut next_id = 0;
-        self.face_ids = face
-            .iter()
-            .map(|&f| {
-                if id[f] == 0 {
-                    next_id += 1;
-                    id[f] = next_id;
-                }
-                id[f]
-            })
-            .collect();
+        self.face_ids = face.into_iter().map(|f| f as i32 + 1).collect();
         self.face_names.clear();
         self.valid = false;
     }
