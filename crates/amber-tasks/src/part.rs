@@ -466,8 +466,6 @@ mod tests {
         }
     }
 
-    /// The unit cube with its six sides as CAD faces 1..=6 (z = 0, z = 1, y = 0, y = 1, x = 0,
-    /// x = 1), meshed at size 0.3.
     /// M⁰ of the boundary of an expert mesh (reads `../shared/data/console`) at the sizes where
     /// TetGen failed on every remeshed surface with the background mesh of its vertices: filled,
     /// its tets the solid's volume (within the chords' loss on curved faces).
@@ -484,6 +482,8 @@ mod tests {
         }
     }
 
+    /// The unit cube with its six sides as CAD faces 1..=6 (z = 0, z = 1, y = 0, y = 1, x = 0,
+    /// x = 1), meshed at size 0.3.
     fn unit_cube_part() -> SolidPart {
         let v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
         let sides = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];

@@ -118,7 +118,8 @@ pub fn generate_3d(
     field: &impl SizingField<3>,
     params: &Mesh3dParams,
 ) -> Result<Mesh3, Mesh3dError> {
-    let mut out = fill_surface(&adapt_surface(reference, field, params)?, field, params);
+    let first = adapt_surface(reference, field, params)?;
+    let mut out = fill_surface(&first, field, params);
     for shrink in SURFACE_RETRY_SHRINK {
         match out {
             Err(Mesh3dError::Tetgen(TetgenError::Internal)) => {
@@ -133,9 +134,8 @@ pub fn generate_3d(
         // boundary of the expert mesh train/015.nas at an M⁰ size of 5.45: without it, TetGen
         // fills each retry's surface): the sizes at the surface's vertices alone, which TetGen
         // interpolates inside.
-        let surface = adapt_surface(reference, field, params)?;
-        let sizes = surface_sizes(&surface, field, params)?;
-        out = fill_sampled(&surface, &sizes, None, params);
+        let sizes = surface_sizes(&first, field, params)?;
+        out = fill_sampled(&first, &sizes, None, params);
     }
     out
 }
@@ -201,7 +201,6 @@ pub fn fill_surface(
     field: &impl SizingField<3>,
     params: &Mesh3dParams,
 ) -> Result<Mesh3, Mesh3dError> {
-    let sized = |p: [f64; 3]| checked_size(field, p).map(|h| params.size_factor * h);
     let sizes = surface_sizes(surface, field, params)?;
     let mut samples = surface.vertices().to_vec();
     let mut sample_sizes = sizes.clone();
@@ -222,7 +221,7 @@ pub fn fill_surface(
         }
         for p in missed {
             samples.push(p);
-            sample_sizes.push(sized(p)?);
+            sample_sizes.push(scaled_size(field, params, p)?);
         }
         mesh = fill_sampled(surface, &sizes, Some((&samples, &sample_sizes)), params)?;
     }
@@ -235,7 +234,12 @@ fn surface_sizes(
     field: &impl SizingField<3>,
     params: &Mesh3dParams,
 ) -> Result<Vec<f64>, Mesh3dError> {
-    surface.vertices().iter().map(|&p| checked_size(field, p).map(|h| params.size_factor * h)).collect()
+    surface.vertices().iter().map(|&p| scaled_size(field, params, p)).collect()
+}
+
+/// The field at `p`, scaled by the params' size factor.
+fn scaled_size(field: &impl SizingField<3>, params: &Mesh3dParams, p: [f64; 3]) -> Result<f64, Mesh3dError> {
+    checked_size(field, p).map(|h| params.size_factor * h)
 }
 
 /// A tet deeper inside the solid than this many sizes (its own or the field's, the smaller) is
