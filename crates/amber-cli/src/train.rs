@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use amber_experiments::{Method, ModelCard, amber_config, commit, merge_json, train_folder, train_poisson};
+use amber_experiments::{Method, ModelCard, amber_config, merge_json, train_folder, train_poisson, training_commits};
 use amber_stdx::read_json;
 use amber_tasks::folder::{Split, mesh_dimension};
 use amber_tasks::poisson::{Difficulty, INITIAL_SIZE};
@@ -71,8 +71,8 @@ impl TrainingArgs {
         Ok(config)
     }
 
-    /// Writes the card of the model trained with `config` into `model` (a run's model directory)
-    /// and returns it.
+    /// Writes the card of the model trained with `config` into `model` (a run's model directory,
+    /// whose run names the commits that trained it) and returns it.
     pub fn write_card(
         &self,
         model: &Path,
@@ -81,6 +81,9 @@ impl TrainingArgs {
         trained: Trained,
     ) -> anyhow::Result<ModelCard> {
         let MethodConfig::Amber(amber) = config else { bail!("amber trains AMBER models") };
+        let run = model.parent().unwrap_or(model);
+        let commit =
+            training_commits(run)?.with_context(|| format!("{}: no record of the training's commit", run.display()))?;
         let card = ModelCard {
             task,
             method: self.method.to_string(),
@@ -88,7 +91,7 @@ impl TrainingArgs {
             initial_size: trained.initial_size,
             command: std::env::args().collect::<Vec<_>>().join(" "),
             data: trained.data,
-            commit: commit().to_owned(),
+            commit,
             training_seconds: trained.seconds,
             evaluation: None,
             calibration: None,

@@ -292,6 +292,17 @@ fn trains_a_smoke_model_resumes_it_and_generates_with_it() {
         .map(|v| v["step"].as_u64().unwrap())
         .collect();
     assert_eq!(steps, (1..=40).collect::<Vec<_>>(), "every step logged once, across the kill");
+    // Both sessions are recorded (one, had the first finished before the kill), the second from
+    // the checkpoint it resumed; one commit ran both, and the card names it alone.
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("training_time.json")).unwrap()).unwrap();
+    let sessions = record["sessions"].as_array().unwrap();
+    assert!(matches!(sessions.len(), 1 | 2), "{record}");
+    assert_eq!(sessions[0]["first_step"], 0);
+    assert!(sessions.get(1).is_none_or(|s| s["first_step"].as_u64().unwrap() >= 10), "{record}");
+    let card: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("model/card.json")).unwrap()).unwrap();
+    assert_eq!(card["commit"], sessions[0]["commit"]);
 
     // The model meshes a problem's domain from its load alone, scored against the problem's expert.
     let problem_file = data.join("easy/val/000.json");

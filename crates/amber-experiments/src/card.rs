@@ -30,7 +30,8 @@ pub struct ModelCard {
     pub command: String,
     /// The training data.
     pub data: String,
-    /// The commit of the code that trained it (`-dirty`: with uncommitted changes).
+    /// The commit of the code that trained it (`-dirty`: with uncommitted changes), or, for a
+    /// run resumed by other code, each session's with the step it started from.
     pub commit: String,
     /// Wall time of the training, seconds.
     pub training_seconds: f64,

@@ -32,5 +32,5 @@ pub use profiles::{Task, amber_config, cnn_config};
 pub use progress::{TrainingProgress, item_bar};
 pub use report::{built_from_a_clean_commit, commit, config_hash, machine, merge_json, write_atomic, write_json};
 pub use results::{ExperimentResults, ProblemEvaluation, RunKey, RunResult, RunThreads, StepEvaluation};
-pub use run::train_run;
+pub use run::{train_run, training_commits};
 pub use table::{markdown as markdown_table, row_label};

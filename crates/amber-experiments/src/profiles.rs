@@ -6,7 +6,7 @@
 
 use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::LOG_ERROR_INDICATOR_COLUMN;
-use amber_train::{CnnConfig, MethodConfig, Objective, Profile, TrainingConfig};
+use amber_train::{CnnConfig, DataConfig, MethodConfig, Objective, Profile, TrainingConfig};
 
 use crate::{Method, MethodSpec};
 use serde::{Deserialize, Serialize};
@@ -82,6 +82,11 @@ pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
             // the paper's already reads (the paper's Console network goes without it).
             if task != Task::Console && !config.inputs.iter().any(|i| i == LOG_SIZE_COLUMN) {
                 config.inputs.push(LOG_SIZE_COLUMN.into());
+            }
+            if task != Task::Console {
+                // A folder trains on every part it holds (the generic profiles' 20 is Poisson's
+                // split); validation, which only reports, keeps its first 20.
+                config.data.train_problems = DataConfig::MAX_PROBLEMS;
             }
             if profile != Profile::Paper {
                 config.inputs.extend(PROFILE_GEOMETRY_INPUTS.map(String::from));
@@ -188,6 +193,8 @@ mod tests {
             let (mut console, mut folder) =
                 (amber_config(Task::Console, profile), amber_config(Task::Folder { dimension: 3 }, profile));
             (console.inputs, folder.inputs) = (Vec::new(), Vec::new());
+            assert_eq!(folder.data.train_problems, DataConfig::MAX_PROBLEMS, "a folder trains on all its parts");
+            folder.data.train_problems = console.data.train_problems;
             assert_eq!(console, folder, "{profile:?}");
             assert_eq!(cnn_config(Task::Console, profile, 32), cnn_config(Task::Folder { dimension: 3 }, profile, 32));
         }

@@ -100,14 +100,21 @@ impl TrainingObserver for TrainingProgress {
     fn validation(&mut self, step: u64, s: &EvaluationSummary) {
         let per_step: Vec<String> = s.steps.iter().map(|t| format!("{:.3}", t.normalised_dcd)).collect();
         let last = s.steps.last();
+        // A failed rollout scores as the mesh it stopped at: say what the others score.
+        let failed = match last {
+            Some(t) if t.failed > 0 => match t.normalised_dcd_successful {
+                Some(ok) => format!("{} failed, the others {ok:.3}", t.failed),
+                None => format!("{} failed", t.failed),
+            },
+            _ => "0 failed".into(),
+        };
         self.println(&format!(
             "validation at step {step} ({:.0} s): normalised DCD per generation step {} ({:.0} elements, expert \
-             {:.0}, {} failed)",
+             {:.0}, {failed})",
             self.started.elapsed().as_secs_f64(),
             per_step.join(", "),
             last.map_or(0.0, |t| t.elements),
             s.expert_elements,
-            last.map_or(0, |t| t.failed),
         ));
     }
 

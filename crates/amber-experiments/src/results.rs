@@ -114,6 +114,10 @@ pub struct RunResult {
     /// The threads behind those times (absent in runs recorded before they were kept).
     #[serde(default)]
     pub threads: RunThreads,
+    /// The commit that trained the model, or each session's where a resumed run's differ
+    /// (absent where the run recorded none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trained_by: Option<String>,
     /// Every test problem's rollout: the values the means above reduce.
     pub problems: Vec<ProblemEvaluation>,
 }
@@ -186,6 +190,7 @@ impl RunResult {
             train_seconds: key.train_seconds,
             eval_seconds: key.eval_seconds,
             threads: key.threads,
+            trained_by: None,
             problems: problems.to_vec(),
         }
     }

@@ -44,6 +44,10 @@ pub(crate) struct CachedEvaluation {
     #[serde(default)]
     pub threads: RunThreads,
     pub problems: Vec<ProblemEvaluation>,
+    /// The commits that trained the model, read from its run directory's record (not cached:
+    /// runs evaluated before it was kept have it too).
+    #[serde(skip)]
+    pub trained_by: Option<String>,
 }
 
 impl CachedEvaluation {
@@ -55,6 +59,7 @@ impl CachedEvaluation {
             train_seconds: folds.iter().map(|f| f.train_seconds).sum(),
             eval_seconds: folds.iter().map(|f| f.eval_seconds).sum(),
             threads: RunThreads::common(folds.iter().map(|f| f.threads)),
+            trained_by: distinct_commits(folds.iter().map(|f| f.trained_by.as_deref())),
             problems: folds.into_iter().flat_map(|f| f.problems).collect(),
         }
     }
@@ -70,8 +75,21 @@ impl CachedEvaluation {
             eval_seconds: self.eval_seconds,
             threads: self.threads,
         };
-        RunResult::new(key, &self.problems)
+        RunResult { trained_by: self.trained_by.clone(), ..RunResult::new(key, &self.problems) }
     }
+}
+
+/// The distinct commits of `commits` in order of appearance, comma-separated (`None` if any is
+/// unknown).
+fn distinct_commits<'a>(commits: impl IntoIterator<Item = Option<&'a str>>) -> Option<String> {
+    let mut distinct: Vec<&str> = Vec::new();
+    for commit in commits {
+        let commit = commit?;
+        if !distinct.contains(&commit) {
+            distinct.push(commit);
+        }
+    }
+    Some(distinct.join(", "))
 }
 
 /// What the model card of an experiment's runs says about their task and data.
@@ -165,7 +183,7 @@ impl Run {
             let cached: CachedEvaluation = read_json(&cache)?;
             println!("{}: reusing the evaluation in {}", self.label, cache.display());
             self.write_card(&cached)?;
-            return Ok(cached);
+            return Ok(CachedEvaluation { trained_by: self.training_record()?.commits(), ..cached });
         }
         let train_seconds = train(&self.dir, &self.label)?;
         let started = Instant::now();
@@ -186,9 +204,16 @@ impl Run {
             test.len(),
             eval_seconds
         );
-        let threads = RunThreads { train: self.training_record()?.threads, eval: Some(rayon::current_num_threads()) };
-        let evaluated =
-            CachedEvaluation { test_set: self.test_name.clone(), train_seconds, eval_seconds, threads, problems };
+        let record = self.training_record()?;
+        let threads = RunThreads { train: record.threads, eval: Some(rayon::current_num_threads()) };
+        let evaluated = CachedEvaluation {
+            test_set: self.test_name.clone(),
+            train_seconds,
+            eval_seconds,
+            threads,
+            problems,
+            trained_by: record.commits(),
+        };
         write_json(&cache, &evaluated)?;
         self.write_card(&evaluated)?;
         Ok(evaluated)
@@ -213,9 +238,10 @@ impl Run {
             threads: evaluated.threads,
         };
         let result = RunResult::new(key, &evaluated.problems);
+        let commit = record.commits();
         let card = ModelCard {
             command: record.command.unwrap_or_else(|| "unknown (trained before runs recorded it)".into()),
-            commit: record.commit.unwrap_or_else(|| "unknown (trained before runs recorded it)".into()),
+            commit: commit.unwrap_or_else(|| "unknown (trained before runs recorded it)".into()),
             training_seconds: evaluated.train_seconds,
             evaluation: Some(CardEvaluation::of(&evaluated.test_set, &result)),
             ..self.card.clone()
@@ -225,8 +251,7 @@ impl Run {
 
     /// What the run directory records of its training (nothing before it trained).
     fn training_record(&self) -> anyhow::Result<TrainingRecord> {
-        let path = self.dir.join(TIME_FILE);
-        Ok(if path.exists() { read_json(&path)? } else { TrainingRecord::default() })
+        TrainingRecord::read(&self.dir)
     }
 
     fn gallery_path(&self, problem: usize, step: usize) -> PathBuf {
@@ -292,8 +317,15 @@ pub fn train_run<const D: usize, P: Problem<D>>(
     progress.finish()
 }
 
-/// Training wall time, accumulated over resumed sessions, and the command and commit of the
-/// last session.
+/// The commits that trained the run in `dir`, as a model card names them: one commit, or each
+/// session's with the step it started at when a resumed run's sessions ran different code
+/// (`None` if the directory holds no record of them).
+pub fn training_commits(dir: &Path) -> anyhow::Result<Option<String>> {
+    Ok(TrainingRecord::read(dir)?.commits())
+}
+
+/// Training wall time, accumulated over resumed sessions, the command, commit and threads of the
+/// last session, and the commit of every session.
 #[derive(Default, Serialize, Deserialize)]
 struct TrainingRecord {
     seconds: f64,
@@ -306,16 +338,52 @@ struct TrainingRecord {
     /// The threads of the last session (absent in runs trained before they were recorded).
     #[serde(default)]
     threads: Option<usize>,
+    /// Every session, first to last (empty in runs trained before they were recorded).
+    #[serde(default)]
+    sessions: Vec<TrainingSession>,
+}
+
+/// One session of a run's training: the code that ran it, from which step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct TrainingSession {
+    commit: String,
+    first_step: u64,
 }
 
 impl TrainingRecord {
-    fn now(seconds: f64, finished: bool) -> Self {
+    fn read(dir: &Path) -> anyhow::Result<Self> {
+        let path = dir.join(TIME_FILE);
+        Ok(if path.exists() { read_json(&path)? } else { Self::default() })
+    }
+
+    fn now(seconds: f64, finished: bool, sessions: Vec<TrainingSession>) -> Self {
         Self {
             seconds,
             finished,
             command: Some(std::env::args().collect::<Vec<_>>().join(" ")),
             commit: Some(commit().to_owned()),
             threads: Some(rayon::current_num_threads()),
+            sessions,
+        }
+    }
+
+    /// See [`training_commits`].
+    fn commits(&self) -> Option<String> {
+        let mut runs: Vec<&TrainingSession> = Vec::new();
+        for session in &self.sessions {
+            if runs.last().is_none_or(|last| last.commit != session.commit) {
+                runs.push(session);
+            }
+        }
+        match runs.as_slice() {
+            [] => self.commit.clone(),
+            [only] => Some(only.commit.clone()),
+            _ => Some(
+                runs.iter()
+                    .map(|s| format!("{} (from step {})", s.commit, s.first_step))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            ),
         }
     }
 }
@@ -344,20 +412,37 @@ struct TimedProgress {
     time_path: PathBuf,
     before: f64,
     started: Instant,
+    /// The earlier sessions' and this one's (last).
+    sessions: Vec<TrainingSession>,
 }
 
 impl TimedProgress {
     /// Progress of the run in `dir` of `total` steps, its clock continuing from the time
     /// recorded there.
     fn start(dir: &Path, label: &str, total: u64) -> anyhow::Result<Self> {
-        let time_path = dir.join(TIME_FILE);
-        let before = if time_path.exists() { read_json::<TrainingRecord>(&time_path)?.seconds } else { 0.0 };
-        Ok(Self { inner: TrainingProgress::new(label, 0, total), time_path, before, started: Instant::now() })
+        let record = TrainingRecord::read(dir)?;
+        let mut sessions = record.sessions;
+        if sessions.is_empty() && record.seconds > 0.0 {
+            // A run recorded before its sessions were: its last session's commit from step 0.
+            let commit = record.commit.unwrap_or_else(|| "unknown".into());
+            sessions.push(TrainingSession { commit, first_step: 0 });
+        }
+        sessions.push(TrainingSession { commit: commit().to_owned(), first_step: 0 });
+        Ok(Self {
+            inner: TrainingProgress::new(label, 0, total),
+            time_path: dir.join(TIME_FILE),
+            before: record.seconds,
+            started: Instant::now(),
+            sessions,
+        })
     }
 
     /// The run stands at step `done` (it resumed there).
-    fn resume_at(&self, done: u64) {
+    fn resume_at(&mut self, done: u64) {
         self.inner.set_position(done);
+        if let Some(session) = self.sessions.last_mut() {
+            session.first_step = done;
+        }
     }
 
     fn seconds(&self) -> f64 {
@@ -367,13 +452,13 @@ impl TimedProgress {
     /// Records the run as finished; returns its total training time.
     fn finish(self) -> anyhow::Result<f64> {
         self.inner.finish();
-        let time = TrainingRecord::now(self.seconds(), true);
+        let time = TrainingRecord::now(self.seconds(), true, self.sessions.clone());
         write_json(&self.time_path, &time)?;
         Ok(time.seconds)
     }
 
     fn record(&mut self) {
-        let time = TrainingRecord::now(self.seconds(), false);
+        let time = TrainingRecord::now(self.seconds(), false, self.sessions.clone());
         if let Err(e) = write_json(&self.time_path, &time) {
             self.inner.println(&format!("warning: {e:#}"));
         }
@@ -392,5 +477,30 @@ impl TrainingObserver for TimedProgress {
     fn checkpoint(&mut self, step: u64, dir: &Path) {
         self.inner.checkpoint(step, dir);
         self.record();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn session(commit: &str, first_step: u64) -> TrainingSession {
+        TrainingSession { commit: commit.into(), first_step }
+    }
+
+    #[test]
+    fn a_card_names_every_commit_that_trained_a_resumed_run() {
+        let record = |sessions| TrainingRecord { commit: Some("c".into()), sessions, ..TrainingRecord::default() };
+        assert_eq!(record(vec![]).commits().as_deref(), Some("c"), "a run recorded before its sessions");
+        assert_eq!(record(vec![session("a", 0), session("a", 500)]).commits().as_deref(), Some("a"));
+        let mixed = record(vec![session("a", 0), session("a", 500), session("b-dirty", 1000), session("a", 1100)]);
+        assert_eq!(mixed.commits().as_deref(), Some("a (from step 0), b-dirty (from step 1000), a (from step 1100)"));
+        assert_eq!(TrainingRecord::default().commits(), None);
+    }
+
+    #[test]
+    fn pooled_folds_name_their_distinct_commits() {
+        assert_eq!(distinct_commits([Some("a"), Some("b"), Some("a")]).as_deref(), Some("a, b"));
+        assert_eq!(distinct_commits([Some("a"), None]), None);
     }
 }

@@ -153,6 +153,12 @@ pub fn markdown(results: &ExperimentResults, paper: &PaperNumber) -> String {
         }
     }
     let _ = writeln!(md, "\nCommit `{}`; machine: {}.", results.commit, results.machine);
+    // A run trained by other code than the one collecting it is named, so that the table never
+    // claims one commit made numbers that another did.
+    for r in results.runs.iter().filter(|r| r.trained_by.as_deref().is_some_and(|c| c != results.commit)) {
+        let trained_by = r.trained_by.as_deref().unwrap_or_default();
+        let _ = writeln!(md, "\n{} {} seed {} was trained by `{trained_by}`.", row_label(r), r.difficulty, r.seed);
+    }
     md
 }
 

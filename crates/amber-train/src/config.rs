@@ -51,6 +51,12 @@ pub struct DataConfig {
     pub val_problems: usize,
 }
 
+impl DataConfig {
+    /// The most problems of a split a run reads (a bound a machine can hold, so that a typo is
+    /// an error, not an abort).
+    pub const MAX_PROBLEMS: usize = 100_000;
+}
+
 impl Default for DataConfig {
     fn default() -> Self {
         Self { train_problems: 20, val_problems: 20 }

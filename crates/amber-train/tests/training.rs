@@ -271,6 +271,28 @@ fn fields_over_the_budget_are_skipped_or_scaled_to_it() {
 }
 
 #[test]
+fn validation_scales_a_field_over_the_budget_to_it_as_evaluation_does() {
+    // A budget of a tenth of the largest expert: an untrained model's fields are over it.
+    let config = TrainingConfig { budget_factor: 0.1, ..tiny_config(1) };
+    let training = Training::new(config, problems(&[11, 12])).unwrap();
+    let val = problems(&[13]);
+    let evaluation = Evaluation::new(&val, training.limits()).unwrap();
+    let sizing = AmberSizing { network: training.network(), predictor: training.predictor() };
+    let (skipped, _) = evaluation.run(&sizing, 2).unwrap();
+    assert!(
+        matches!(skipped[0].steps[0].status, StepStatus::OverBudget { .. }),
+        "the model's own limits skip the field: {:?}",
+        skipped[0].steps[0].status
+    );
+    let summary = training.validate(&evaluation).unwrap();
+    let budget = training.limits().max_elements as f64;
+    for step in &summary.steps {
+        assert_eq!(step.failed, 0, "{summary:?}");
+        assert!(step.elements <= 1.1 * budget, "{} elements for a budget of {budget}", step.elements);
+    }
+}
+
+#[test]
 fn the_optional_features_reach_a_saved_model_that_predicts_on_new_meshes() {
     let inputs = [LOG_SIZE_COLUMN, LOG_LOAD_COLUMN, LOG_ERROR_INDICATOR_COLUMN].map(String::from).to_vec();
     let config = TrainingConfig { inputs, ..tiny_config(3) };

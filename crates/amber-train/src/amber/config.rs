@@ -269,8 +269,8 @@ impl TrainingConfig {
             ("network.message_passing_steps", self.network.message_passing_steps as u64, 256),
             ("batch_nodes", self.batch_nodes as u64, 100_000_000),
             ("buffer_capacity", self.buffer_capacity as u64, 1_000_000),
-            ("data.train_problems", self.data.train_problems as u64, 100_000),
-            ("data.val_problems", self.data.val_problems as u64, 100_000),
+            ("data.train_problems", self.data.train_problems as u64, DataConfig::MAX_PROBLEMS as u64),
+            ("data.val_problems", self.data.val_problems as u64, DataConfig::MAX_PROBLEMS as u64),
             ("inference_steps", self.inference_steps as u64, Self::MAX_INFERENCE_STEPS as u64),
         ];
         if let Some((field, value, max)) = limits.into_iter().find(|&(_, value, max)| value > max) {

@@ -392,9 +392,13 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         self.save_model(&out_dir.join(MODEL_DIR))
     }
 
-    /// Rolls out the current model on `validation` (evaluation mode) and summarises.
+    /// Rolls out the current model on `validation` (evaluation mode) and summarises; a field
+    /// over the budget is scaled to it, as `amber evaluate` does, rather than skipped (a skipped
+    /// first step would score as M⁰ and hide what the model does).
     pub fn validate(&self, validation: &Evaluation<'_, D, P>) -> Result<EvaluationSummary> {
-        let sizing = AmberSizing { network: self.network(), predictor: &self.predictor };
+        let mut predictor = self.predictor.clone();
+        predictor.limits.scale_to_budget = true;
+        let sizing = AmberSizing { network: self.network(), predictor: &predictor };
         Ok(validation.run(&sizing, self.config.inference_steps)?.1)
     }
 
