@@ -54,7 +54,8 @@ const PROFILE_GEOMETRY_INPUTS: [&str; 4] =
 /// AMBER's configuration of `task` under `profile` (before the method's labels and the seed).
 /// Console is one folder dataset of 3D parts meshed by human experts: it and every 3D folder get
 /// the same values but one (a folder trains on all its parts, Console on the paper's split's), so
-/// `amber train --data` on the Console folder trains what `reproduce console --all-train` does.
+/// `amber train --data` on the Console folder with `--initial-size 4.3955` (M⁰'s size, else the
+/// folder's rule) trains what `reproduce console --all-train` does.
 pub fn amber_config(task: Task, profile: Profile) -> TrainingConfig {
     let mut config = TrainingConfig::profile(profile);
     match task {
