@@ -6,7 +6,7 @@ use std::path::Path;
 use amber_plot::{Bar, Series, Tile, bar_chart, line_chart};
 
 use crate::method::MethodSpec;
-use crate::report::{write_atomic, write_json};
+use crate::report::{built_from_a_clean_commit, write_atomic, write_json};
 use crate::results::{ExperimentResults, RunResult};
 use crate::table::{self, PaperNumber, mean};
 
@@ -25,6 +25,17 @@ pub(crate) fn write_outputs(
     methods: &[MethodSpec],
     paper: &PaperNumber,
 ) -> anyhow::Result<()> {
+    // The committed evidence comes from committed code: the runs' as well as the collecting
+    // build's (which the command checks; a dirty build's results say so in their commit).
+    let dirty = results.runs_trained_by_uncommitted_code();
+    if out.starts_with("results") && built_from_a_clean_commit() && !dirty.is_empty() {
+        anyhow::bail!(
+            "{}: runs trained by uncommitted code cannot go under results/ from a clean commit: {}; retrain them \
+             (--force) or write elsewhere (--out)",
+            out.display(),
+            dirty.join("; ")
+        );
+    }
     write_json(&out.join("results.json"), results)?;
     write_atomic(&out.join("table.md"), table::markdown(results, paper).as_bytes())?;
     let runs_of = |setting: &str, spec: &MethodSpec| -> Vec<&RunResult> {

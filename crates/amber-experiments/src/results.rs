@@ -234,6 +234,18 @@ impl ExperimentResults {
         }
     }
 
+    /// The runs trained (in some session) by code with uncommitted changes, each as
+    /// "method setting seed r (trained by …)".
+    pub fn runs_trained_by_uncommitted_code(&self) -> Vec<String> {
+        self.runs
+            .iter()
+            .filter_map(|r| {
+                let commits = r.trained_by.as_deref().filter(|c| c.contains("-dirty"))?;
+                Some(format!("{} {} seed {} (trained by {commits})", crate::row_label(r), r.difficulty, r.seed))
+            })
+            .collect()
+    }
+
     /// The problems the runs were evaluated on, for captions: the test problems, the split a
     /// task without a test split fell back to (`config.test_split`), or the training parts of a
     /// cross-validation (`config.experiment.folds`).
@@ -308,6 +320,41 @@ mod tests {
         let common = RunThreads::common([threads(1, 2), threads(1, 1), threads(1, 2)]);
         assert_eq!(common, RunThreads { train: Some(1), eval: None });
         assert_eq!(RunThreads::common([]), RunThreads::default());
+    }
+
+    #[test]
+    fn runs_trained_by_uncommitted_code_are_named() {
+        let key = |seed| RunKey {
+            method: "amber-mean",
+            variant: "default",
+            difficulty: "console",
+            seed,
+            train_seconds: 1.0,
+            eval_seconds: 1.0,
+            threads: RunThreads::default(),
+        };
+        let run = |seed, trained_by: Option<&str>| RunResult {
+            trained_by: trained_by.map(String::from),
+            ..RunResult::new(key(seed), &[evaluation(&[0.5], false)])
+        };
+        let results = ExperimentResults {
+            schema: RESULTS_SCHEMA,
+            amber_version: "0.1.0".into(),
+            experiment: "console".into(),
+            profile: "quick".into(),
+            commit: "0123abc".into(),
+            machine: serde_json::json!({}),
+            config: serde_json::json!({}),
+            runs: vec![
+                run(0, Some("0123abc")),
+                run(1, Some("0123abc (from step 0), 4567def-dirty (from step 500)")),
+                run(2, None),
+            ],
+        };
+        assert_eq!(
+            results.runs_trained_by_uncommitted_code(),
+            ["amber-mean console seed 1 (trained by 0123abc (from step 0), 4567def-dirty (from step 500))"]
+        );
     }
 
     #[test]
