@@ -322,6 +322,20 @@ mod tests {
         assert_eq!(RunThreads::common([]), RunThreads::default());
     }
 
+    /// Quick Console results of commit `0123abc` with `config` and `runs`.
+    fn console_results(config: serde_json::Value, runs: Vec<RunResult>) -> ExperimentResults {
+        ExperimentResults {
+            schema: RESULTS_SCHEMA,
+            amber_version: "0.1.0".into(),
+            experiment: "console".into(),
+            profile: "quick".into(),
+            commit: "0123abc".into(),
+            machine: serde_json::json!({}),
+            config,
+            runs,
+        }
+    }
+
     #[test]
     fn runs_trained_by_uncommitted_code_are_named() {
         let key = |seed| RunKey {
@@ -337,20 +351,12 @@ mod tests {
             trained_by: trained_by.map(String::from),
             ..RunResult::new(key(seed), &[evaluation(&[0.5], false)])
         };
-        let results = ExperimentResults {
-            schema: RESULTS_SCHEMA,
-            amber_version: "0.1.0".into(),
-            experiment: "console".into(),
-            profile: "quick".into(),
-            commit: "0123abc".into(),
-            machine: serde_json::json!({}),
-            config: serde_json::json!({}),
-            runs: vec![
-                run(0, Some("0123abc")),
-                run(1, Some("0123abc (from step 0), 4567def-dirty (from step 500)")),
-                run(2, None),
-            ],
-        };
+        let runs = vec![
+            run(0, Some("0123abc")),
+            run(1, Some("0123abc (from step 0), 4567def-dirty (from step 500)")),
+            run(2, None),
+        ];
+        let results = console_results(serde_json::json!({}), runs);
         assert_eq!(
             results.runs_trained_by_uncommitted_code(),
             ["amber-mean console seed 1 (trained by 0123abc (from step 0), 4567def-dirty (from step 500))"]
@@ -359,16 +365,7 @@ mod tests {
 
     #[test]
     fn captions_name_the_split_that_was_evaluated() {
-        let results = |config| ExperimentResults {
-            schema: RESULTS_SCHEMA,
-            amber_version: "0.1.0".into(),
-            experiment: "console".into(),
-            profile: "quick".into(),
-            commit: "0123abc".into(),
-            machine: serde_json::json!({}),
-            config,
-            runs: Vec::new(),
-        };
+        let results = |config| console_results(config, Vec::new());
         assert_eq!(
             results(serde_json::json!({ "test_split": "val" })).evaluated_on(),
             "the val problems (no test split)"
