@@ -98,6 +98,24 @@ impl TrainingObserver for TrainingProgress {
     }
 
     fn validation(&mut self, step: u64, s: &EvaluationSummary) {
+        self.validation_line(&format!("validation at step {step}"), s);
+    }
+
+    fn final_validation(&mut self, step: u64, s: &EvaluationSummary) {
+        self.validation_line(
+            &format!("validation at step {step} with the last generation step fitted (the saved model)"),
+            s,
+        );
+    }
+
+    fn checkpoint(&mut self, step: u64, dir: &Path) {
+        self.bar.set_message(format!("checkpoint at step {step}: {}", dir.display()));
+    }
+}
+
+impl TrainingProgress {
+    /// One line of a validation's scores, `what` naming the validation.
+    fn validation_line(&self, what: &str, s: &EvaluationSummary) {
         let per_step: Vec<String> = s.steps.iter().map(|t| format!("{:.3}", t.normalised_dcd)).collect();
         let last = s.steps.last();
         // A failed rollout scores as the mesh it stopped at: say what the others score.
@@ -109,17 +127,12 @@ impl TrainingObserver for TrainingProgress {
             _ => "0 failed".into(),
         };
         self.println(&format!(
-            "validation at step {step} ({:.0} s): normalised DCD per generation step {} ({:.0} elements, expert \
-             {:.0}, {failed})",
+            "{what} ({:.0} s): normalised DCD per generation step {} ({:.0} elements, expert {:.0}, {failed})",
             self.started.elapsed().as_secs_f64(),
             per_step.join(", "),
             last.map_or(0.0, |t| t.elements),
             s.expert_elements,
         ));
-    }
-
-    fn checkpoint(&mut self, step: u64, dir: &Path) {
-        self.bar.set_message(format!("checkpoint at step {step}: {}", dir.display()));
     }
 }
 

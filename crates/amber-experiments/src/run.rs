@@ -474,6 +474,10 @@ impl TrainingObserver for TimedProgress {
         self.inner.validation(step, summary);
     }
 
+    fn final_validation(&mut self, step: u64, summary: &EvaluationSummary) {
+        self.inner.final_validation(step, summary);
+    }
+
     fn checkpoint(&mut self, step: u64, dir: &Path) {
         self.inner.checkpoint(step, dir);
         self.record();

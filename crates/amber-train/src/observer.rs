@@ -45,6 +45,10 @@ pub trait TrainingObserver {
     fn step(&mut self, _report: &StepReport, _total_steps: u64) {}
     /// After every validation rollout (AMBER only: the CNN does not validate).
     fn validation(&mut self, _step: u64, _summary: &EvaluationSummary) {}
+    /// After the final step's fit (`calibrate_element_count`), the validation of the model as
+    /// saved: what `amber evaluate` gives on the validation problems, where the last
+    /// [`validation`](Self::validation) came before the fit.
+    fn final_validation(&mut self, _step: u64, _summary: &EvaluationSummary) {}
     /// After every checkpoint.
     fn checkpoint(&mut self, _step: u64, _dir: &Path) {}
 }

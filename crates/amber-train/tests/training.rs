@@ -9,8 +9,8 @@ use amber_graph::EdgeFeature;
 use amber_tasks::LOG_SIZE_COLUMN;
 use amber_tasks::poisson::{INITIAL_SIZE, LOG_ERROR_INDICATOR_COLUMN, LOG_LOAD_COLUMN, PoissonProblem};
 use amber_train::{
-    AmberModel, AmberSizing, DataConfig, Evaluation, MODEL_DIR, NetworkConfig, Predictor, ReplayBuffer, StepReport,
-    StepStatus, Training, TrainingConfig, TrainingObserver, WEIGHTS_FILE, rollouts,
+    AmberModel, AmberSizing, DataConfig, Evaluation, EvaluationSummary, MODEL_DIR, NetworkConfig, Predictor,
+    ReplayBuffer, StepReport, StepStatus, Training, TrainingConfig, TrainingObserver, WEIGHTS_FILE, rollouts,
 };
 
 /// Problems with small experts (8 refinement steps: a few hundred triangles).
@@ -290,6 +290,60 @@ fn validation_scales_a_field_over_the_budget_to_it_as_evaluation_does() {
         assert_eq!(step.failed, 0, "{summary:?}");
         assert!(step.elements <= 1.1 * budget, "{} elements for a budget of {budget}", step.elements);
     }
+}
+
+/// Records the validations a training run reports.
+#[derive(Default)]
+struct Validations {
+    periodic: Vec<(u64, EvaluationSummary)>,
+    fitted: Vec<(u64, EvaluationSummary)>,
+}
+
+impl TrainingObserver for Validations {
+    fn validation(&mut self, step: u64, summary: &EvaluationSummary) {
+        self.periodic.push((step, summary.clone()));
+    }
+
+    fn final_validation(&mut self, step: u64, summary: &EvaluationSummary) {
+        self.fitted.push((step, summary.clone()));
+    }
+}
+
+/// The last validation of a calibrated run scores the saved model, its last step fitted, as
+/// `amber evaluate` would; a run resumed at its end redoes it rather than logging it twice.
+#[test]
+fn a_calibrated_run_validates_the_saved_model_once_more() {
+    let config = TrainingConfig { calibrate_element_count: true, validation_interval: 4, ..tiny_config(4) };
+    let (train, val) = (problems(&[41, 42]), problems(&[43]));
+    let dir = tempfile::tempdir().unwrap();
+    let mut seen = Validations::default();
+    let limits = single_thread(|| {
+        let mut training = Training::new(config.clone(), train.clone()).unwrap();
+        let evaluation = Evaluation::new(&val, training.limits()).unwrap();
+        training.run(dir.path(), Some(&evaluation), &mut seen).unwrap();
+        training.limits().clone()
+    });
+    assert_eq!(seen.periodic.iter().map(|v| v.0).collect::<Vec<_>>(), [4]);
+    assert_eq!(seen.fitted.iter().map(|v| v.0).collect::<Vec<_>>(), [4]);
+
+    let mut model = AmberModel::load(&dir.path().join(MODEL_DIR)).unwrap();
+    assert_ne!(model.predictor.limits.final_step_scale, 1.0, "the saved model's last step is fitted");
+    // Validation scales a field over the budget to it, as `amber evaluate` does.
+    model.predictor.limits.scale_to_budget = true;
+    let evaluation = Evaluation::new(&val, &limits).unwrap();
+    let (_, saved) = single_thread(|| evaluation.run(&model.sizing(), config.inference_steps)).unwrap();
+    assert_eq!(seen.fitted[0].1, saved, "the final validation scores the saved model");
+
+    let validations = |kind: &str| {
+        let log = std::fs::read_to_string(dir.path().join(amber_train::LOG_FILE)).unwrap();
+        log.lines().filter(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["kind"] == kind).count()
+    };
+    single_thread(|| {
+        let mut resumed = Training::open(config.clone(), train.clone(), dir.path()).unwrap();
+        let evaluation = Evaluation::new(&val, resumed.limits()).unwrap();
+        resumed.run(dir.path(), Some(&evaluation), &mut ()).unwrap();
+    });
+    assert_eq!((validations("validation"), validations("final_validation")), (1, 1));
 }
 
 #[test]

@@ -352,8 +352,9 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
 
     /// Trains until `config.steps`, from wherever the run stands: logs every step to
     /// `out_dir/train.jsonl`, validates on `validation` every `validation_interval` steps and at
-    /// the end, checkpoints every `checkpoint_interval` steps and at the end, and writes the
-    /// final model to `out_dir/model`.
+    /// the end, checkpoints every `checkpoint_interval` steps and at the end, fits the final
+    /// step (with `calibrate_element_count`, then validating the fitted model once more), and
+    /// writes the final model to `out_dir/model`.
     pub fn run(
         &mut self,
         out_dir: &Path,
@@ -388,6 +389,13 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             let fit = fit_final_step(&sizing, &self.problems, self.config.inference_steps)?;
             self.predictor.limits.final_step_scale = fit.scale;
             self.predictor.limits.final_count = self.config.count_regression.then_some(fit.count);
+            if let Some(validation) = validation
+                && self.config.validation_interval > 0
+            {
+                let summary = self.validate(validation)?;
+                log.write(&LogRecord::FinalValidation { step: self.step, summary: &summary })?;
+                observer.final_validation(self.step, &summary);
+            }
         }
         self.save_model(&out_dir.join(MODEL_DIR))
     }
@@ -482,11 +490,20 @@ fn random_orthogonal<const D: usize>(rng: &mut ChaCha8Rng) -> [[f64; D]; D] {
 #[serde(tag = "kind", rename_all = "snake_case")]
 enum LogRecord<'a> {
     Step(&'a AmberStepReport),
-    Validation { step: u64, summary: &'a EvaluationSummary },
+    Validation {
+        step: u64,
+        summary: &'a EvaluationSummary,
+    },
+    /// The model as saved, after the final step's fit.
+    FinalValidation {
+        step: u64,
+        summary: &'a EvaluationSummary,
+    },
 }
 
 /// The JSON-lines log, appended to; on resume, records after the checkpoint are dropped first
-/// (they belong to the killed run's lost steps and will be redone).
+/// (they belong to the killed run's lost steps and will be redone), and so is the final
+/// validation, which every run to the end redoes.
 struct TrainingLog {
     file: std::fs::File,
     path: PathBuf,
@@ -498,10 +515,9 @@ impl TrainingLog {
             Ok(text) => text
                 .lines()
                 .filter(|line| {
-                    serde_json::from_str::<serde_json::Value>(line)
-                        .ok()
-                        .and_then(|v| v.get("step").and_then(|s| s.as_u64()))
-                        .is_some_and(|s| s <= completed_steps)
+                    serde_json::from_str::<serde_json::Value>(line).ok().is_some_and(|v| {
+                        v["kind"] != "final_validation" && v["step"].as_u64().is_some_and(|s| s <= completed_steps)
+                    })
                 })
                 .map(|line| format!("{line}\n"))
                 .collect(),
