@@ -321,7 +321,7 @@ fn a_calibrated_run_validates_the_saved_model_once_more() {
         let mut training = Training::new(config.clone(), train.clone()).unwrap();
         let evaluation = Evaluation::new(&val, training.limits()).unwrap();
         training.run(dir.path(), Some(&evaluation), &mut seen).unwrap();
-        training.limits().clone()
+        *training.limits()
     });
     assert_eq!(seen.periodic.iter().map(|v| v.0).collect::<Vec<_>>(), [4]);
     assert_eq!(seen.fitted.iter().map(|v| v.0).collect::<Vec<_>>(), [4]);
