@@ -521,7 +521,7 @@ fn trains_and_evaluates_a_folder_of_expert_meshes() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
     // The last validation line scores the saved model, its last generation step fitted.
-    let last = stderr.lines().filter(|l| l.contains("validation at step")).last().unwrap_or_default();
+    let last = stderr.lines().rfind(|l| l.contains("validation at step")).unwrap_or_default();
     assert!(last.contains("step 30 with the last generation step fitted"), "{stderr}");
     let card: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(run.join("model/card.json")).unwrap()).unwrap();
