@@ -364,15 +364,15 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
         std::fs::create_dir_all(out_dir).map_err(io_error(out_dir))?;
         write_json_atomic(&out_dir.join(CONFIG_FILE), &self.config)?;
         let mut log = TrainingLog::open(&out_dir.join(LOG_FILE), self.step)?;
-        let total = self.config.steps;
+        let (total, interval) = (self.config.steps, self.config.validation_interval);
+        // An interval of 0 turns validation off.
+        let validation = validation.filter(|_| interval > 0);
         while self.step < total {
             let report = self.train_step()?;
             log.write(&LogRecord::Step(&report))?;
             observer.step(&StepReport::Amber(report), total);
             let (step, last) = (self.step, self.step == total);
-            let interval = self.config.validation_interval;
             if let Some(validation) = validation
-                && interval > 0
                 && (step.is_multiple_of(interval) || last)
             {
                 let summary = self.validate(validation)?;
@@ -389,9 +389,7 @@ impl<const D: usize, P: Problem<D>> Training<D, P> {
             let fit = fit_final_step(&sizing, &self.problems, self.config.inference_steps)?;
             self.predictor.limits.final_step_scale = fit.scale;
             self.predictor.limits.final_count = self.config.count_regression.then_some(fit.count);
-            if let Some(validation) = validation
-                && self.config.validation_interval > 0
-            {
+            if let Some(validation) = validation {
                 let summary = self.validate(validation)?;
                 log.write(&LogRecord::FinalValidation { step: self.step, summary: &summary })?;
                 observer.final_validation(self.step, &summary);
