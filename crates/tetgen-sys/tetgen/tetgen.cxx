@@ -18689,8 +18689,17 @@ int tetgenmesh::recoveredgebyflips(point startpt, point endpt,
   fc.seg[1] = endpt;
   fc.checkflipeligibility = 1;
 
+  // amber: every pass of Loop I flips away one face or edge that crosses the missing edge, and
+  // such a sequence of flips can come back to where it started and go round forever (seen while
+  // recovering a segment of a remeshed Console surface with -Y); past this many flips stop with
+  // TetGen's "internal error" code instead of hanging.
+  long amber_flips = 0;
+
   // The mainloop of the edge reocvery.
   while (1) { // Loop I
+    if (++amber_flips > 10000) {
+      terminatetetgen(this, 2); // amber
+    }
 
     // Search the edge from 'startpt'.
     point2tetorg(startpt, *searchtet);

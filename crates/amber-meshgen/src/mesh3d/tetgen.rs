@@ -562,6 +562,39 @@ mod tests {
         assert!(tetrahedralize(&cube(1), None, None, &TetgenSwitches::default()).is_ok());
     }
 
+    /// Reads `tests/data/segment-flip-cycle.txt`: `points N`, N lines `x y z`, `triangles M`,
+    /// M lines of three point indices; `#` lines are comments.
+    fn segment_flip_cycle() -> Plc {
+        let text = include_str!("../../tests/data/segment-flip-cycle.txt");
+        let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+        let mut rows = |name: &str| -> Vec<[String; 3]> {
+            let count = lines.next().unwrap().strip_prefix(name).unwrap().trim().parse().unwrap();
+            let row = |l: &str| <[String; 3]>::try_from(l.split(' ').map(str::to_owned).collect::<Vec<_>>()).unwrap();
+            lines.by_ref().take(count).map(row).collect()
+        };
+        let points = rows("points").iter().map(|p| p.each_ref().map(|x| x.parse().unwrap())).collect();
+        let triangles: Vec<[u32; 3]> =
+            rows("triangles").iter().map(|t| t.each_ref().map(|x| x.parse().unwrap())).collect();
+        let face_markers = vec![1; triangles.len()];
+        Plc { points, triangles, face_markers }
+    }
+
+    #[test]
+    fn segment_recovery_that_flips_in_circles_is_an_internal_error() {
+        // Unbounded, TetGen flips the same faces round and round while recovering one segment
+        // of this PLC and never returns.
+        let plc = segment_flip_cycle();
+        assert_eq!((plc.points.len(), plc.triangles.len()), (2060, 5));
+        for switches in
+            [TetgenSwitches::default(), TetgenSwitches { quality: None, optimization: None, ..Default::default() }]
+        {
+            let err = tetrahedralize(&plc, None, None, &switches).unwrap_err();
+            assert!(matches!(err, TetgenError::Internal), "{err}");
+        }
+        // The lock was released and TetGen still works.
+        assert!(tetrahedralize(&cube(1), None, None, &TetgenSwitches::default()).is_ok());
+    }
+
     #[test]
     fn bad_input_is_rejected_before_tetgen() {
         let mut plc = cube(1);
