@@ -26,6 +26,12 @@
 
 #define REAL double // dorival
 
+// amber: the most flips that recovering one missing segment (recoveredgebyflips) or facet
+// (recoverfacebyflips) may take. Each flip removes one face or edge crossing it, but a sequence
+// of them can come back to where it started and go round forever; past this bound TetGen stops
+// with its "internal error" code instead of hanging.
+static const long amber_max_recovery_flips = 10000;
+
 //// io_cxx ///////////////////////////////////////////////////////////////////
 ////                                                                       ////
 ////                                                                       ////
@@ -18689,15 +18695,11 @@ int tetgenmesh::recoveredgebyflips(point startpt, point endpt,
   fc.seg[1] = endpt;
   fc.checkflipeligibility = 1;
 
-  // amber: every pass of Loop I flips away one face or edge that crosses the missing edge, and
-  // such a sequence of flips can come back to where it started and go round forever (seen while
-  // recovering a segment of a remeshed Console surface with -Y); past this many flips stop with
-  // TetGen's "internal error" code instead of hanging.
-  long amber_flips = 0;
+  long amber_flips = 0; // amber
 
   // The mainloop of the edge reocvery.
   while (1) { // Loop I
-    if (++amber_flips > 10000) {
+    if (++amber_flips > amber_max_recovery_flips) {
       terminatetetgen(this, 2); // amber
     }
 
@@ -19595,8 +19597,12 @@ int tetgenmesh::recoverfacebyflips(point pa, point pb, point pc,
   fc.checkflipeligibility = 1;
   success = 0;
 
+  long amber_flips = 0; // amber
   for (i = 0; i < 3 && !success; i++) {
     while (1) {
+      if (++amber_flips > amber_max_recovery_flips) {
+        terminatetetgen(this, 2); // amber
+      }
       // Get a tet containing the edge [a,b].
       point2tetorg(fc.fac[i], *searchtet);
       dir = finddirection(searchtet, fc.fac[(i+1)%3]);
