@@ -22,7 +22,8 @@ use std::ffi::{c_char, c_double, c_int};
 pub const AMBER_TETGEN_OK: c_int = 0;
 /// TetGen ran out of memory (its code 1, or `std::bad_alloc`).
 pub const AMBER_TETGEN_OUT_OF_MEMORY: c_int = 1;
-/// TetGen hit an internal error or a failed internal assertion (its code 2).
+/// TetGen hit an internal error, a failed internal assertion, or one of the step bounds amber
+/// added to loops that can go round forever (its code 2; see `tetgen/NOTICE.md`).
 pub const AMBER_TETGEN_INTERNAL_ERROR: c_int = 2;
 /// The input facets intersect each other (TetGen code 3).
 pub const AMBER_TETGEN_SELF_INTERSECTION: c_int = 3;

@@ -139,7 +139,7 @@ pub enum TetgenError {
     /// TetGen code 1.
     #[error("TetGen ran out of memory (code 1)")]
     OutOfMemory,
-    /// TetGen code 2, also a failed internal assertion.
+    /// TetGen code 2, also a failed internal assertion or a loop past its step bound.
     #[error("TetGen hit an internal error (code 2)")]
     Internal,
     /// TetGen code 3.
