@@ -19,7 +19,7 @@ mod objective;
 pub mod op;
 pub mod reduce;
 
-pub use adam::{Adam, clip_grad_norm, grad_norm};
+pub use adam::Adam;
 pub use backend::Backend;
 pub use finite::first_non_finite;
 pub use objective::{Objective, softplus, softplus_inverse};

@@ -183,14 +183,14 @@ fn weight_grad<T: Float>(x: &[T], dy: &[T], n: usize, c: usize, o: usize, unfold
     let (p, taps) = (unfold.positions(), unfold.taps());
     let tile_rows = unfold.tile_rows(c);
     let tiles = unfold.rows.div_ceil(tile_rows);
-    sum_over_items(n * tiles, o * c * taps, |item, threads, acc: &mut [T], scratch| {
+    sum_over_items(n * tiles, o * c * taps, tile_rows * unfold.row_len, |item, threads, acc: &mut [T], scratch| {
         let (image, tile) = (item / tiles, item % tiles);
         let rows = tile * tile_rows..((tile + 1) * tile_rows).min(unfold.rows);
         let (start, width) = (rows.start * unfold.row_len, rows.len() * unfold.row_len);
         let cols = scratch.take(c * taps * width);
         unfold.im2col(&x[image * c * p..(image + 1) * c * p], c, rows, cols);
         let dy = Strided { ptr: dy[image * o * p + start..].as_ptr(), rows: p as isize, cols: 1 };
-        // SAFETY: `acc` is this item's own accumulator; operands are in bounds.
+        // SAFETY: `acc` is lent to this item alone while it runs; operands are in bounds.
         unsafe {
             matmul(o, c * taps, width, acc.as_mut_ptr(), c * taps, true, dy, Strided::transposed(cols, width), threads);
         }

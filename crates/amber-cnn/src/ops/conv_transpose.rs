@@ -117,7 +117,7 @@ fn backward<T: Float>(x: &[T], w: &[T], dy: &[T], blocks: &Blocks, want_dx: bool
     let mut dx = want_dx.then(|| vec![T::zero(); blocks.n * c * p]);
     let dx_ptr = SharedMut(dx.as_mut().map_or(std::ptr::null_mut(), |d| d.as_mut_ptr()));
     let (width, tiles) = blocks.tiling();
-    let dw = sum_over_items(blocks.n * tiles, c * o * k, |item, threads, acc: &mut [T], scratch| {
+    let dw = sum_over_items(blocks.n * tiles, c * o * k, width, |item, threads, acc: &mut [T], scratch| {
         let (image, tile) = (item / tiles, item % tiles);
         let range = tile * width..((tile + 1) * width).min(p);
         let t = range.len();
@@ -132,7 +132,7 @@ fn backward<T: Float>(x: &[T], w: &[T], dy: &[T], blocks: &Blocks, want_dx: bool
             }
         }
         let xs = Strided { ptr: x[image * c * p + range.start..].as_ptr(), rows: p as isize, cols: 1 };
-        // SAFETY: `acc` is this item's accumulator and the dx columns of this tile are written by
+        // SAFETY: `acc` is lent to this item alone while it runs, and the dx columns of this tile are written by
         // this item alone; operands are in bounds.
         unsafe {
             matmul(c, o * k, t, acc.as_mut_ptr(), o * k, true, xs, Strided::transposed(dz, t), threads);
