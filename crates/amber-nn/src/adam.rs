@@ -1,6 +1,7 @@
 //! Adam with global gradient-norm clipping whose moments can be saved and restored, so that a
 //! resumed run continues exactly (candle's `AdamW` keeps its state private). The update is
-//! candle's `AdamW` with zero weight decay.
+//! candle's `AdamW` with zero weight decay; on the CPU it overwrites the weights and moments in
+//! place instead of allocating a tensor per operation, with the same rounding.
 
 use std::collections::HashMap;
 use std::path::Path;
